@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The test command: installs missing dependencies, builds, builds the tests, runs every gtest
+# and rostest through catkin, and exits non-zero if any test failed (catkin's run_tests alone
+# exits 0 on failure, so the verdict comes from catkin_test_results).
+set -uo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
+
+bash "$YS_ROOT/scripts/install_deps.sh" || exit 1
+bash "$YS_ROOT/scripts/build.sh" || { echo "test.sh: build failed"; exit 1; }
+bash "$YS_ROOT/scripts/build.sh" tests || { echo "test.sh: building tests failed"; exit 1; }
+
+cd "$YS_WS"
+rm -rf build/test_results
+source devel/setup.bash
+# One test at a time: the rostests each start a master, and the machine has two cores.
+catkin_make -j1 run_tests -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 > build/run_tests.log 2>&1
+grep -E "^\[ *(RUN|  OK|  FAILED|  PASSED) |FAILURE|Failure|error:" build/run_tests.log | grep -v "^\[ RUN" | tail -200 || true
+
+echo "----------------------------------------------------------------"
+catkin_test_results build/test_results --verbose > build/test_summary.txt 2>&1
+status=$?
+grep -v "^Skipping" build/test_summary.txt | tail -40
+if [ $status -ne 0 ]; then
+  echo "test.sh: FAILED (see $YS_WS/build/run_tests.log)"
+  exit 1
+fi
+echo "test.sh: all tests passed ($(tail -1 build/test_summary.txt))"

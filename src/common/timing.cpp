@@ -1,0 +1,33 @@
+#include "yolo_slam/common/timing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+namespace yolo_slam {
+
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  s.count = v.size();
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.min = v.front();
+  s.max = v.back();
+  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  const size_t n = v.size();
+  s.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  // Nearest-rank percentile.
+  size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(n)));
+  s.p95 = v[std::min(n - 1, rank == 0 ? 0 : rank - 1)];
+  return s;
+}
+
+std::string summaryJsonMs(const Summary& s) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "{\"count\": %zu, \"median_ms\": %.3f, \"mean_ms\": %.3f, \"p95_ms\": %.3f}",
+                s.count, s.median, s.mean, s.p95);
+  return buf;
+}
+
+}  // namespace yolo_slam
