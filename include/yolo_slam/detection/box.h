@@ -1,0 +1,21 @@
+#pragma once
+#include <opencv2/core/types.hpp>
+
+#include <string>
+#include <vector>
+
+namespace yolo_slam {
+namespace detection {
+
+// One detected object: class from the model's names file, score in [0,1], pixel box clipped
+// to the image (x, y = top-left corner; width, height in pixels).
+struct Box {
+  int class_id = -1;
+  std::string label;
+  float score = 0.f;
+  cv::Rect2f rect;
+};
+using Boxes = std::vector<Box>;
+
+}  // namespace detection
+}  // namespace yolo_slam

@@ -1,0 +1,31 @@
+#pragma once
+// The keypoints of one RGB-D frame as they travel from extraction through screening into
+// tracking (and, in ROS, across the Screening -> Slam nodelet topic). Plain value type.
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace yolo_slam {
+namespace features {
+
+struct FeatureFrame {
+  double stamp = 0.0;
+  int width = 0, height = 0;                 // image size in pixels
+  std::vector<cv::KeyPoint> keypoints;       // as detected (distorted image coordinates)
+  std::vector<cv::KeyPoint> keypoints_un;    // undistorted (equal to keypoints without distortion)
+  cv::Mat descriptors;                       // N x 32 CV_8U, rotated BRIEF (256 bits)
+  std::vector<float> depth;                  // metres per keypoint; <= 0 means no valid depth
+  std::vector<float> right_u;                // virtual right coordinate u - bf/d; < 0 if no depth
+  std::vector<uint8_t> dynamic;              // 1 = screened as dynamic (never used by SLAM)
+
+  size_t size() const { return keypoints.size(); }
+  size_t countDynamic() const {
+    size_t n = 0;
+    for (uint8_t d : dynamic) n += d ? 1 : 0;
+    return n;
+  }
+};
+
+}  // namespace features
+}  // namespace yolo_slam
