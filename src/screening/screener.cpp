@@ -1,0 +1,351 @@
+#include "yolo_slam/screening/screener.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/timing.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+
+namespace yolo_slam {
+namespace screening {
+
+DynamicMode parseDynamicMode(const std::string& s) {
+  if (s == "off") return DynamicMode::Off;
+  if (s == "detect") return DynamicMode::Detect;
+  if (s == "geometry") return DynamicMode::Geometry;
+  if (s == "detect+geometry") return DynamicMode::DetectGeometry;
+  throw Error("unknown dynamic mode '" + s +
+              "'; use one of off, detect, geometry, detect+geometry");
+}
+
+std::string toString(DynamicMode m) {
+  switch (m) {
+    case DynamicMode::Off: return "off";
+    case DynamicMode::Detect: return "detect";
+    case DynamicMode::Geometry: return "geometry";
+    case DynamicMode::DetectGeometry: return "detect+geometry";
+  }
+  return "?";
+}
+
+ScreeningVariant parseScreeningVariant(const std::string& s) {
+  if (s == "paper") return ScreeningVariant::Paper;
+  if (s == "refit") return ScreeningVariant::Refit;
+  throw Error("unknown screening variant '" + s + "'; use paper or refit");
+}
+
+std::string toString(ScreeningVariant v) {
+  return v == ScreeningVariant::Paper ? "paper" : "refit";
+}
+
+void ScreeningOptions::validate(const std::string& where) const {
+  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
+  if (!(variance_threshold_m2 > 0) || !std::isfinite(variance_threshold_m2))
+    bad("variance threshold must be > 0 (m^2), got " + std::to_string(variance_threshold_m2));
+  if (!(probability > 0 && probability < 1))
+    bad("probability must be in (0, 1), got " + std::to_string(probability));
+  if (max_iterations < 1) bad("maxIterations must be >= 1, got " + std::to_string(max_iterations));
+  if (!(box_dilation >= 0 && box_dilation <= 1))
+    bad("boxDilation must be in [0, 1], got " + std::to_string(box_dilation));
+  if (!(refit_sigma > 0) || !std::isfinite(refit_sigma))
+    bad("refitSigma must be > 0, got " + std::to_string(refit_sigma));
+}
+
+ScreeningOptions ScreeningOptions::load(const Config& cfg) {
+  ScreeningOptions o;
+  const std::string file = cfg.path().empty() ? std::string("<config>") : cfg.path();
+  auto rethrow = [&](const std::string& key, const Error& e) {
+    throw Error(file + ": key '" + key + "': " + e.what());
+  };
+  try {
+    o.mode = parseDynamicMode(cfg.getString("Screening.mode", toString(o.mode)));
+  } catch (const Error& e) {
+    if (std::string(e.what()).rfind(file, 0) == 0) throw;
+    rethrow("Screening.mode", e);
+  }
+  try {
+    o.variant = parseScreeningVariant(cfg.getString("Screening.variant", toString(o.variant)));
+  } catch (const Error& e) {
+    if (std::string(e.what()).rfind(file, 0) == 0) throw;
+    rethrow("Screening.variant", e);
+  }
+  o.variance_threshold_m2 = cfg.getDouble("Screening.varianceThreshold", o.variance_threshold_m2);
+  o.probability = cfg.getDouble("Screening.probability", o.probability);
+  o.max_iterations = cfg.getInt("Screening.maxIterations", o.max_iterations);
+  int seed = cfg.getInt("Screening.seed", static_cast<int>(o.seed));
+  if (seed < 0) throw Error(file + ": key 'Screening.seed' must be >= 0, got " + std::to_string(seed));
+  o.seed = static_cast<unsigned>(seed);
+  std::string nd = cfg.getString("Screening.noDepth", o.no_depth_dynamic ? "dynamic" : "static");
+  if (nd == "dynamic") {
+    o.no_depth_dynamic = true;
+  } else if (nd == "static") {
+    o.no_depth_dynamic = false;
+  } else {
+    throw Error(file + ": key 'Screening.noDepth' must be dynamic or static, got '" + nd + "'");
+  }
+  o.box_dilation = cfg.getDouble("Screening.boxDilation", o.box_dilation);
+  o.refit_sigma = cfg.getDouble("Screening.refitSigma", o.refit_sigma);
+  o.validate(file + ": Screening.*");
+  return o;
+}
+
+double adaptiveIterations(double w, double probability, int sample_size) {
+  if (w <= 0) return std::numeric_limits<double>::infinity();
+  if (w >= 1) return 0.0;
+  double all_inliers = std::pow(w, sample_size);
+  double denom = std::log(1.0 - all_inliers);
+  if (denom >= 0) return std::numeric_limits<double>::infinity();  // w^N underflowed
+  return std::log(1.0 - probability) / denom;
+}
+
+Screener::Screener(const ScreeningOptions& options) : opt_(options) { opt_.validate(); }
+
+ConsensusResult Screener::depthRansac(const std::vector<float>& depths, unsigned seed) const {
+  ConsensusResult res;
+  const int n = static_cast<int>(depths.size());
+  if (n == 0) return res;
+  if (n == 1) {
+    // A single point is trivially the box's only depth cluster.
+    res.members = {0};
+    return res;
+  }
+  const double thr = opt_.variance_threshold_m2;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> pick_first(0, n - 1), pick_second(0, n - 2);
+
+  // k starts unbounded (paper) and is capped by max_iterations.
+  double k = std::numeric_limits<double>::infinity();
+  int best_count = 0;
+  double best_mean = 0, best_var = 0;
+  std::vector<int> current, best;
+  current.reserve(n);
+  int iter = 0;
+  while (iter < k && iter < opt_.max_iterations) {
+    ++iter;
+    int a = pick_first(rng);
+    int b = pick_second(rng);
+    if (b >= a) ++b;  // two distinct keypoints
+    const double da = depths[a], db = depths[b];
+    const double mean2 = 0.5 * (da + db);
+    const double var1 = 0.25 * (da - db) * (da - db);  // Eq. 5 with N = 2
+    current.clear();
+    // The sampled pair defines the model; it belongs to the set when its own variance passes.
+    if (var1 < thr) {
+      current.push_back(a);
+      current.push_back(b);
+    }
+    for (int i = 0; i < n; ++i) {
+      if (i == a || i == b) continue;
+      // CalcDepthVariance(var1, Dpoint3): Eq. 5 over the pair plus this point (N = 3), updated
+      // incrementally: S3 = S2 + (x - m2)^2 * 2/3, var2 = S3 / 3.
+      const double dx = depths[i] - mean2;
+      const double var2 = (2.0 * var1 + dx * dx * (2.0 / 3.0)) / 3.0;
+      if (var2 < thr) current.push_back(i);
+    }
+    const int count = static_cast<int>(current.size());
+    if (count > best_count) {
+      best_count = count;
+      best.swap(current);
+      best_mean = mean2;
+      best_var = var1;
+      k = adaptiveIterations(static_cast<double>(best_count) / n, opt_.probability, 2);
+    }
+  }
+  res.iterations = iter;
+
+  if (opt_.variant == ScreeningVariant::Refit && best_count >= 2) {
+    // Re-estimate the cluster from all its members: centre = consensus mean, half-width =
+    // refit_sigma * consensus std, but never narrower than the model's acceptance interval.
+    double sum = 0, sum2 = 0;
+    for (int i : best) sum += depths[i];
+    const double mu = sum / best_count;
+    for (int i : best) sum2 += (depths[i] - mu) * (depths[i] - mu);
+    const double sd = std::sqrt(sum2 / best_count);
+    // Acceptance interval of the best model: |x - mean2| < sqrt(1.5 * (3 thr - 2 var1)).
+    const double accept = std::sqrt(std::max(0.0, 1.5 * (3.0 * thr - 2.0 * best_var)));
+    const double half = std::max(opt_.refit_sigma * sd, accept);
+    (void)best_mean;
+    best.clear();
+    for (int i = 0; i < n; ++i)
+      if (std::abs(depths[i] - mu) < half) best.push_back(i);
+  }
+  std::sort(best.begin(), best.end());
+  res.members = std::move(best);
+  return res;
+}
+
+namespace {
+
+cv::Rect2f dilate(const cv::Rect2f& r, double f) {
+  const float dx = static_cast<float>(r.width * f), dy = static_cast<float>(r.height * f);
+  return {r.x - dx, r.y - dy, r.width + 2 * dx, r.height + 2 * dy};
+}
+
+bool inside(const cv::Rect2f& r, const cv::Point2f& p) {
+  return p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height;
+}
+
+}  // namespace
+
+ScreeningStats Screener::screen(features::FeatureFrame& frame,
+                                const detection::Boxes& boxes) const {
+  Stopwatch sw;
+  ScreeningStats st;
+  const size_t n = frame.keypoints.size();
+  if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
+  if (frame.depth.size() != n && opt_.mode != DynamicMode::Off && opt_.mode != DynamicMode::Detect) {
+    throw Error("screening: frame has " + std::to_string(n) + " keypoints but " +
+                std::to_string(frame.depth.size()) + " depths; build it with buildFeatureFrame");
+  }
+  if (opt_.mode == DynamicMode::Off) {
+    st.ms = sw.ms();
+    return st;
+  }
+
+  std::vector<uint8_t> in_any(n, 0), drop(n, 0);
+  std::vector<int> members;
+  std::vector<float> depths;
+  members.reserve(n);
+  depths.reserve(n);
+
+  // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + r so regions are
+  // independent of each other and of previous frames.
+  auto screenRegion = [&](const std::vector<int>& idx, unsigned region) {
+    depths.clear();
+    members.clear();
+    for (int i : idx) {
+      if (frame.depth[i] > 0) {
+        depths.push_back(frame.depth[i]);
+        members.push_back(i);
+      } else if (opt_.no_depth_dynamic) {
+        drop[i] = 1;
+      }
+    }
+    ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
+    st.iterations += r.iterations;
+    for (int m : r.members) drop[members[m]] = 1;
+  };
+
+  std::vector<int> idx;
+  idx.reserve(n);
+  if (opt_.mode == DynamicMode::Geometry) {
+    // The whole image is one box.
+    for (size_t i = 0; i < n; ++i) idx.push_back(static_cast<int>(i));
+    std::fill(in_any.begin(), in_any.end(), 1);
+    screenRegion(idx, 0);
+  } else {
+    unsigned region = 0;
+    for (const auto& box : boxes) {
+      const cv::Rect2f r = dilate(box.rect, opt_.box_dilation);
+      idx.clear();
+      for (size_t i = 0; i < n; ++i) {
+        if (inside(r, frame.keypoints[i].pt)) {
+          idx.push_back(static_cast<int>(i));
+          in_any[i] = 1;
+        }
+      }
+      if (opt_.mode == DynamicMode::Detect) {
+        for (int i : idx) drop[i] = 1;
+      } else {
+        screenRegion(idx, region);
+      }
+      ++region;
+    }
+  }
+
+  for (size_t i = 0; i < n; ++i) {
+    if (!in_any[i]) continue;
+    ++st.in_boxes;
+    if (drop[i]) {
+      frame.dynamic[i] = 1;
+      ++st.dropped;
+    } else {
+      ++st.kept;
+    }
+  }
+  st.ms = sw.ms();
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double ScreeningMetrics::dynamicRecall() const {
+  return dynamic_total > 0 ? static_cast<double>(dynamic_dropped) / dynamic_total : 1.0;
+}
+
+double ScreeningMetrics::staticRetention() const {
+  return static_in_boxes > 0 ? static_cast<double>(static_in_boxes_kept) / static_in_boxes : 1.0;
+}
+
+ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
+  dynamic_total += o.dynamic_total;
+  dynamic_dropped += o.dynamic_dropped;
+  static_in_boxes += o.static_in_boxes;
+  static_in_boxes_kept += o.static_in_boxes_kept;
+  static_total += o.static_total;
+  static_dropped += o.static_dropped;
+  return *this;
+}
+
+std::string ScreeningMetrics::toJson() const {
+  std::ostringstream os;
+  os.precision(6);
+  os << "{\"dynamic_total\":" << dynamic_total << ",\"dynamic_dropped\":" << dynamic_dropped
+     << ",\"dynamic_recall\":" << dynamicRecall() << ",\"static_in_boxes\":" << static_in_boxes
+     << ",\"static_in_boxes_kept\":" << static_in_boxes_kept
+     << ",\"static_retention\":" << staticRetention() << ",\"static_total\":" << static_total
+     << ",\"static_dropped\":" << static_dropped << "}";
+  return os.str();
+}
+
+ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,
+                                   const detection::Boxes& boxes) {
+  if (mask.empty() || mask.type() != CV_8UC1)
+    throw Error("screening metrics: ground-truth mask must be a non-empty 8-bit single-channel image");
+  if (frame.width > 0 && frame.height > 0 &&
+      (mask.cols != frame.width || mask.rows != frame.height)) {
+    throw Error("screening metrics: mask is " + std::to_string(mask.cols) + "x" +
+                std::to_string(mask.rows) + " but the image is " + std::to_string(frame.width) +
+                "x" + std::to_string(frame.height) + "; use the mask of this frame");
+  }
+  ScreeningMetrics m;
+  for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+    const cv::Point2f& p = frame.keypoints[i].pt;
+    const int x = std::min(mask.cols - 1, std::max(0, static_cast<int>(std::lround(p.x))));
+    const int y = std::min(mask.rows - 1, std::max(0, static_cast<int>(std::lround(p.y))));
+    const bool dyn_gt = mask.at<uint8_t>(y, x) > 127;
+    const bool dropped = i < frame.dynamic.size() && frame.dynamic[i];
+    if (dyn_gt) {
+      ++m.dynamic_total;
+      m.dynamic_dropped += dropped ? 1 : 0;
+      continue;
+    }
+    ++m.static_total;
+    m.static_dropped += dropped ? 1 : 0;
+    bool in_box = false;
+    for (const auto& b : boxes) in_box = in_box || inside(b.rect, p);
+    if (in_box) {
+      ++m.static_in_boxes;
+      m.static_in_boxes_kept += dropped ? 0 : 1;
+    }
+  }
+  return m;
+}
+
+cv::Mat loadMask(const std::string& path) {
+  cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (m.empty())
+    throw Error(path + ": ground-truth mask missing or unreadable; expected an 8-bit PNG "
+                       "(0 static, 255 dynamic) of the image's size");
+  return m;
+}
+
+}  // namespace screening
+}  // namespace yolo_slam

@@ -1,0 +1,245 @@
+// Algorithm 1 on constructed depth sets, the adaptive k of Eq. 8, determinism and modes.
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/screening/screener.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace yolo_slam;
+using namespace yolo_slam::screening;
+
+namespace {
+
+// A person (depth ~1.5 m, +-0.15 m body relief) standing in front of a wall at 4 m, inside a
+// box x in [100, 300): the person covers x in [150, 250). Outside the box: more wall.
+struct Scene {
+  features::FeatureFrame frame;
+  std::vector<bool> person;
+  detection::Boxes boxes;
+};
+
+Scene makeScene(unsigned seed = 1, int n_person = 120, int n_wall_in_box = 60, int n_out = 100) {
+  Scene s;
+  s.frame.width = 640;
+  s.frame.height = 480;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  auto add = [&](float x, float y, float d, bool person) {
+    s.frame.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
+    s.frame.depth.push_back(d);
+    s.person.push_back(person);
+  };
+  for (int i = 0; i < n_person; ++i) add(150 + 100 * u(rng), 60 + 400 * u(rng), 1.35f + 0.3f * u(rng), true);
+  for (int i = 0; i < n_wall_in_box; ++i) {
+    float x = u(rng) < 0.5f ? 100 + 48 * u(rng) : 252 + 48 * u(rng);
+    add(x, 60 + 400 * u(rng), 3.9f + 0.2f * u(rng), false);
+  }
+  for (int i = 0; i < n_out; ++i) add(350 + 280 * u(rng), 480 * u(rng), 3.9f + 0.2f * u(rng), false);
+  s.frame.keypoints_un = s.frame.keypoints;
+  detection::Box b;
+  b.label = "person";
+  b.score = 0.9f;
+  b.rect = cv::Rect2f(100, 50, 200, 420);
+  s.boxes.push_back(b);
+  return s;
+}
+
+}  // namespace
+
+TEST(AdaptiveIterations, MatchesEquation8) {
+  // k = log(1 - P) / log(1 - w^2)
+  EXPECT_NEAR(adaptiveIterations(0.5, 0.99, 2), std::log(0.01) / std::log(0.75), 1e-12);
+  EXPECT_NEAR(adaptiveIterations(0.5, 0.99, 2), 16.0078, 1e-3);
+  EXPECT_NEAR(adaptiveIterations(0.9, 0.99, 2), 2.7730, 1e-3);
+  EXPECT_TRUE(std::isinf(adaptiveIterations(0.0, 0.99, 2)));
+  EXPECT_EQ(adaptiveIterations(1.0, 0.99, 2), 0.0);
+  // More inliers, fewer iterations.
+  EXPECT_GT(adaptiveIterations(0.3, 0.99, 2), adaptiveIterations(0.6, 0.99, 2));
+}
+
+TEST(DepthRansac, PersonPlaneInFrontOfWallIsTheConsensus) {
+  for (ScreeningVariant v : {ScreeningVariant::Paper, ScreeningVariant::Refit}) {
+    ScreeningOptions o;
+    o.variant = v;
+    o.variance_threshold_m2 = 0.05;
+    Screener scr(o);
+    Scene s = makeScene();
+    ScreeningStats st = scr.screen(s.frame, s.boxes);
+    int person_dropped = 0, wall_box_kept = 0, wall_box = 0, outside_dropped = 0;
+    for (size_t i = 0; i < s.frame.size(); ++i) {
+      const bool in_box = s.boxes[0].rect.contains(s.frame.keypoints[i].pt);
+      if (s.person[i]) person_dropped += s.frame.dynamic[i];
+      else if (in_box) { ++wall_box; wall_box_kept += !s.frame.dynamic[i]; }
+      else outside_dropped += s.frame.dynamic[i];
+    }
+    EXPECT_EQ(person_dropped, 120) << toString(v);
+    EXPECT_EQ(wall_box_kept, wall_box) << toString(v);
+    EXPECT_EQ(outside_dropped, 0) << toString(v);
+    EXPECT_EQ(st.in_boxes, 180);
+    EXPECT_EQ(st.dropped, 120);
+    EXPECT_EQ(st.kept, 60);
+    EXPECT_GT(st.iterations, 0);
+    // w = 120/180: k = log(0.01)/log(1 - 0.444) = 7.8, so RANSAC stops long before the cap.
+    EXPECT_LT(st.iterations, 50);
+  }
+}
+
+TEST(DepthRansac, DeterministicGivenSeed) {
+  ScreeningOptions o;
+  o.variance_threshold_m2 = 0.01;  // tight: several candidate clusters, so sampling matters
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(1.f, 4.f);
+  std::vector<float> d(300);
+  for (float& x : d) x = u(rng);
+  Screener scr(o);
+  ConsensusResult a = scr.depthRansac(d, 42), b = scr.depthRansac(d, 42);
+  EXPECT_EQ(a.members, b.members);
+  EXPECT_EQ(a.iterations, b.iterations);
+  Scene s1 = makeScene(), s2 = makeScene();
+  scr.screen(s1.frame, s1.boxes);
+  scr.screen(s2.frame, s2.boxes);
+  EXPECT_EQ(s1.frame.dynamic, s2.frame.dynamic);
+}
+
+TEST(DepthRansac, IterationsCappedAndSmallSets) {
+  ScreeningOptions o;
+  o.variance_threshold_m2 = 1e-9;  // nothing agrees: w stays 0, k stays infinite
+  o.max_iterations = 37;
+  Screener scr(o);
+  std::vector<float> d;
+  for (int i = 0; i < 50; ++i) d.push_back(1.0f + 0.1f * i);
+  EXPECT_EQ(scr.depthRansac(d, 0).iterations, 37);
+  EXPECT_TRUE(scr.depthRansac({}, 0).members.empty());
+  EXPECT_EQ(scr.depthRansac({2.0f}, 0).members, std::vector<int>{0});
+  ScreeningOptions o2;
+  o2.variance_threshold_m2 = 0.05;
+  o2.variant = ScreeningVariant::Paper;
+  EXPECT_EQ(Screener(o2).depthRansac({2.0f, 2.1f}, 0).members, (std::vector<int>{0, 1}));
+}
+
+TEST(Modes, BehaveAsSpecified) {
+  auto run = [](DynamicMode m, Scene& s) {
+    ScreeningOptions o;
+    o.mode = m;
+    o.variance_threshold_m2 = 0.05;
+    return Screener(o).screen(s.frame, s.boxes);
+  };
+  Scene off = makeScene();
+  ScreeningStats st = run(DynamicMode::Off, off);
+  EXPECT_EQ(off.frame.countDynamic(), 0u);
+  EXPECT_EQ(st.dropped, 0);
+
+  Scene det = makeScene();
+  st = run(DynamicMode::Detect, det);
+  EXPECT_EQ(det.frame.countDynamic(), 180u);  // everything in the box
+  EXPECT_EQ(st.in_boxes, 180);
+  EXPECT_EQ(st.kept, 0);
+
+  // Geometry: the whole image is one box; the dominant depth cluster is the wall (160 of 280
+  // keypoints), which G drops: the paper's reason why G alone is worse than D + G.
+  Scene geo = makeScene();
+  st = run(DynamicMode::Geometry, geo);
+  EXPECT_EQ(st.in_boxes, 280);
+  EXPECT_EQ(geo.frame.countDynamic(), 160u);
+  for (size_t i = 0; i < geo.frame.size(); ++i) EXPECT_EQ(geo.frame.dynamic[i], geo.person[i] ? 0 : 1);
+
+  Scene dg = makeScene();
+  run(DynamicMode::DetectGeometry, dg);
+  EXPECT_EQ(dg.frame.countDynamic(), 120u);
+
+  // No boxes: detect and detect+geometry drop nothing.
+  Scene none = makeScene();
+  none.boxes.clear();
+  EXPECT_EQ(run(DynamicMode::DetectGeometry, none).dropped, 0);
+  EXPECT_EQ(none.frame.countDynamic(), 0u);
+}
+
+TEST(Screener, NoDepthRuleAndExistingLabels) {
+  Scene s = makeScene();
+  s.frame.depth[0] = 0;                   // a person keypoint without depth
+  s.frame.depth[130] = 0;                 // a wall keypoint in the box without depth
+  s.frame.dynamic.assign(s.frame.size(), 0);
+  s.frame.dynamic[250] = 1;               // propagated label outside any box survives
+  ScreeningOptions o;
+  o.variance_threshold_m2 = 0.05;
+  o.no_depth_dynamic = true;
+  Screener(o).screen(s.frame, s.boxes);
+  EXPECT_EQ(s.frame.dynamic[0], 1);
+  EXPECT_EQ(s.frame.dynamic[130], 1);
+  EXPECT_EQ(s.frame.dynamic[250], 1);
+  Scene t = makeScene();
+  t.frame.depth[0] = 0;
+  o.no_depth_dynamic = false;
+  Screener(o).screen(t.frame, t.boxes);
+  EXPECT_EQ(t.frame.dynamic[0], 0);
+  EXPECT_EQ(t.frame.dynamic[1], 1);
+}
+
+TEST(Options, ParseAndLoad) {
+  EXPECT_EQ(parseDynamicMode("off"), DynamicMode::Off);
+  EXPECT_EQ(parseDynamicMode("detect"), DynamicMode::Detect);
+  EXPECT_EQ(parseDynamicMode("geometry"), DynamicMode::Geometry);
+  EXPECT_EQ(parseDynamicMode("detect+geometry"), DynamicMode::DetectGeometry);
+  for (auto m : {DynamicMode::Off, DynamicMode::Detect, DynamicMode::Geometry, DynamicMode::DetectGeometry})
+    EXPECT_EQ(parseDynamicMode(toString(m)), m);
+  EXPECT_THROW(parseDynamicMode("D+G"), Error);
+
+  Config c = Config::fromString(
+      "Screening.mode: \"detect\"\nScreening.variant: \"paper\"\nScreening.varianceThreshold: 0.2\n"
+      "Screening.probability: 0.95\nScreening.maxIterations: 77\nScreening.seed: 5\n"
+      "Screening.noDepth: \"static\"\nScreening.boxDilation: 0.05\n", "s.yaml");
+  ScreeningOptions o = ScreeningOptions::load(c);
+  EXPECT_EQ(o.mode, DynamicMode::Detect);
+  EXPECT_EQ(o.variant, ScreeningVariant::Paper);
+  EXPECT_DOUBLE_EQ(o.variance_threshold_m2, 0.2);
+  EXPECT_DOUBLE_EQ(o.probability, 0.95);
+  EXPECT_EQ(o.max_iterations, 77);
+  EXPECT_EQ(o.seed, 5u);
+  EXPECT_FALSE(o.no_depth_dynamic);
+  EXPECT_DOUBLE_EQ(o.box_dilation, 0.05);
+
+  ScreeningOptions d = ScreeningOptions::load(Config());
+  EXPECT_EQ(d.mode, DynamicMode::DetectGeometry);
+
+  for (const char* bad : {"Screening.mode: \"fast\"\n", "Screening.varianceThreshold: -1\n",
+                          "Screening.probability: 1.5\n", "Screening.noDepth: \"maybe\"\n",
+                          "Screening.maxIterations: 0\n"}) {
+    try {
+      ScreeningOptions::load(Config::fromString(bad, "bad.yaml"));
+      FAIL() << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Metrics, CountsAgainstMask) {
+  Scene s = makeScene();
+  ScreeningOptions o;
+  o.variance_threshold_m2 = 0.05;
+  Screener(o).screen(s.frame, s.boxes);
+  cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(150, 0, 101, 480)).setTo(255);  // person x in [150, 250]
+  ScreeningMetrics m = evaluateScreening(s.frame, mask, s.boxes);
+  EXPECT_EQ(m.dynamic_total, 120);
+  EXPECT_EQ(m.dynamic_dropped, 120);
+  EXPECT_EQ(m.static_in_boxes, 60);
+  EXPECT_EQ(m.static_in_boxes_kept, 60);
+  EXPECT_EQ(m.static_total, 160);
+  EXPECT_DOUBLE_EQ(m.dynamicRecall(), 1.0);
+  EXPECT_DOUBLE_EQ(m.staticRetention(), 1.0);
+  // Detect mode keeps nothing in the box.
+  Scene d = makeScene();
+  o.mode = DynamicMode::Detect;
+  Screener(o).screen(d.frame, d.boxes);
+  ScreeningMetrics md = evaluateScreening(d.frame, mask, d.boxes);
+  EXPECT_DOUBLE_EQ(md.staticRetention(), 0.0);
+  md += m;
+  EXPECT_EQ(md.dynamic_total, 240);
+  EXPECT_NE(m.toJson().find("\"dynamic_recall\":1"), std::string::npos);
+  EXPECT_THROW(evaluateScreening(s.frame, cv::Mat(10, 10, CV_8UC1), s.boxes), Error);
+  EXPECT_THROW(loadMask("/nonexistent/mask.png"), Error);
+}
