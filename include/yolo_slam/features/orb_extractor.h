@@ -1,0 +1,65 @@
+#pragma once
+// ORB feature extraction with ORB-SLAM2's behaviour: a scale pyramid, FAST corners found per
+// 30 px cell with a fallback threshold, a quadtree that spreads the keypoints evenly over each
+// level, intensity-centroid orientation and rotated BRIEF (256 bits) on a blurred image.
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+namespace yolo_slam {
+
+class Config;
+
+namespace features {
+
+struct OrbOptions {
+  int n_features = 1000;      // ORBextractor.nFeatures: total over all levels
+  double scale_factor = 1.2;  // ORBextractor.scaleFactor: between consecutive levels (> 1)
+  int n_levels = 8;           // ORBextractor.nLevels
+  int ini_th_fast = 20;       // ORBextractor.iniThFAST: FAST threshold tried first in a cell
+  int min_th_fast = 7;        // ORBextractor.minThFAST: fallback when a cell has no corner
+
+  // Reads the ORBextractor.* keys above (missing keys keep the defaults). Throws
+  // yolo_slam::Error naming the file and key for out-of-range values.
+  static OrbOptions load(const Config& cfg);
+  // Throws yolo_slam::Error when a value is out of range; `where` prefixes the message.
+  void validate(const std::string& where = "OrbOptions") const;
+};
+
+class OrbExtractor {
+ public:
+  static constexpr int kPatchSize = 31;       // BRIEF / orientation patch diameter
+  static constexpr int kHalfPatchSize = 15;
+  static constexpr int kEdgeThreshold = 19;   // keypoints stay this far from each level's border
+  static constexpr int kCellSize = 30;        // FAST cell size in pixels (per level)
+
+  explicit OrbExtractor(const OrbOptions& options);
+
+  // gray: CV_8UC1 (throws yolo_slam::Error otherwise). Keypoints are in level-0 pixel
+  // coordinates, ordered by level; octave = level, size = 31 * scale^level, angle in degrees
+  // [0, 360), response = FAST score. descriptors: N x 32 CV_8U (0 x 32 when nothing is found).
+  // Deterministic and thread-safe (const; no shared mutable state).
+  void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints,
+               cv::Mat& descriptors) const;
+
+  const OrbOptions& options() const { return options_; }
+  const std::vector<double>& scaleFactors() const { return scale_factors_; }        // s^level
+  const std::vector<double>& invScaleFactors() const { return inv_scale_factors_; }
+  const std::vector<double>& levelSigma2() const { return level_sigma2_; }          // s^(2 level)
+  const std::vector<double>& invLevelSigma2() const { return inv_level_sigma2_; }
+  const std::vector<int>& featuresPerLevel() const { return features_per_level_; }
+
+  // The 256 BRIEF test pairs (x1, y1, x2, y2 each), fixed for the lifetime of the program and
+  // identical across platforms (own Gaussian sampler on std::mt19937 with a fixed seed).
+  static const std::vector<cv::Point>& briefPattern();
+
+ private:
+  OrbOptions options_;
+  std::vector<double> scale_factors_, inv_scale_factors_, level_sigma2_, inv_level_sigma2_;
+  std::vector<int> features_per_level_;
+  std::vector<int> umax_;  // half-width of the circular patch per row offset v = 0..15
+};
+
+}  // namespace features
+}  // namespace yolo_slam

@@ -1,0 +1,403 @@
+#include "yolo_slam/features/orb_extractor.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <random>
+
+namespace yolo_slam {
+namespace features {
+
+// ------------------------------------------------------------------------------------------
+// Options
+// ------------------------------------------------------------------------------------------
+
+void OrbOptions::validate(const std::string& where) const {
+  auto bad = [&](const char* key, const std::string& why) {
+    throw Error(where + ": key '" + key + "' " + why);
+  };
+  if (n_features <= 0) bad("ORBextractor.nFeatures", "must be a positive integer (default 1000)");
+  if (!(scale_factor > 1.0) || !std::isfinite(scale_factor) || scale_factor > 4.0)
+    bad("ORBextractor.scaleFactor", "must be in (1, 4] (default 1.2)");
+  if (n_levels < 1 || n_levels > 32) bad("ORBextractor.nLevels", "must be in [1, 32] (default 8)");
+  if (ini_th_fast < 1 || ini_th_fast > 254)
+    bad("ORBextractor.iniThFAST", "must be in [1, 254] (default 20)");
+  if (min_th_fast < 1 || min_th_fast > ini_th_fast)
+    bad("ORBextractor.minThFAST", "must be in [1, iniThFAST] (default 7)");
+}
+
+OrbOptions OrbOptions::load(const Config& cfg) {
+  OrbOptions o;
+  o.n_features = cfg.getInt("ORBextractor.nFeatures", o.n_features);
+  o.scale_factor = cfg.getDouble("ORBextractor.scaleFactor", o.scale_factor);
+  o.n_levels = cfg.getInt("ORBextractor.nLevels", o.n_levels);
+  o.ini_th_fast = cfg.getInt("ORBextractor.iniThFAST", o.ini_th_fast);
+  o.min_th_fast = cfg.getInt("ORBextractor.minThFAST", o.min_th_fast);
+  o.validate(cfg.path().empty() ? std::string("<config>") : cfg.path());
+  return o;
+}
+
+// ------------------------------------------------------------------------------------------
+// BRIEF sampling pattern
+// ------------------------------------------------------------------------------------------
+
+const std::vector<cv::Point>& OrbExtractor::briefPattern() {
+  // BRIEF "G II" sampling (Calonder et al. 2010): both points of a test drawn from an isotropic
+  // Gaussian with sigma^2 = S^2/25 around the patch centre, S = 31. Points outside the circle of
+  // radius 15 are redrawn so that any rotation of the pattern stays inside the 19 px border.
+  // std::normal_distribution is implementation-defined, so Box-Muller on the raw (standardised)
+  // mt19937 output keeps the pattern identical on every platform.
+  static const std::vector<cv::Point> pattern = [] {
+    std::mt19937 gen(0x0b51a7e5u);
+    const double sigma = kPatchSize / 5.0;
+    auto uniform = [&gen]() { return (static_cast<double>(gen()) + 0.5) / 4294967296.0; };
+    auto samplePoint = [&]() {
+      while (true) {
+        double r = std::sqrt(-2.0 * std::log(uniform())) * sigma;
+        double phi = 2.0 * M_PI * uniform();
+        cv::Point p(static_cast<int>(std::lround(r * std::cos(phi))),
+                    static_cast<int>(std::lround(r * std::sin(phi))));
+        if (p.x * p.x + p.y * p.y <= kHalfPatchSize * kHalfPatchSize) return p;
+      }
+    };
+    std::vector<cv::Point> pts;
+    pts.reserve(512);
+    while (pts.size() < 512) {
+      cv::Point a = samplePoint(), b = samplePoint();
+      if (a == b) continue;  // a test comparing a pixel with itself carries no information
+      pts.push_back(a);
+      pts.push_back(b);
+    }
+    return pts;
+  }();
+  return pattern;
+}
+
+// ------------------------------------------------------------------------------------------
+// Construction: scales and per-level feature budget
+// ------------------------------------------------------------------------------------------
+
+OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
+  options_.validate();
+  const int n = options_.n_levels;
+  scale_factors_.resize(n);
+  inv_scale_factors_.resize(n);
+  level_sigma2_.resize(n);
+  inv_level_sigma2_.resize(n);
+  for (int l = 0; l < n; ++l) {
+    scale_factors_[l] = std::pow(options_.scale_factor, l);
+    inv_scale_factors_[l] = 1.0 / scale_factors_[l];
+    level_sigma2_[l] = scale_factors_[l] * scale_factors_[l];
+    inv_level_sigma2_[l] = 1.0 / level_sigma2_[l];
+  }
+
+  // Geometric budget: level l gets a share proportional to its linear size (factor^l), so the
+  // keypoint density per unit of image area is similar on every level (ORB-SLAM2's formula).
+  features_per_level_.assign(n, 0);
+  const double factor = 1.0 / options_.scale_factor;
+  double desired = options_.n_features * (1.0 - factor) / (1.0 - std::pow(factor, n));
+  int sum = 0;
+  for (int l = 0; l + 1 < n; ++l) {
+    features_per_level_[l] = static_cast<int>(std::lround(desired));
+    sum += features_per_level_[l];
+    desired *= factor;
+  }
+  features_per_level_[n - 1] = std::max(options_.n_features - sum, 0);
+
+  // Half-widths of a digital disk of radius 15. Using u^2 + v^2 <= r^2 + r makes the set
+  // symmetric in u and v, so the centroid of a rotated patch rotates with it.
+  const int r = kHalfPatchSize;
+  umax_.resize(r + 1);
+  for (int v = 0; v <= r; ++v) {
+    umax_[v] = static_cast<int>(std::floor(std::sqrt(static_cast<double>(r * r + r - v * v))));
+  }
+  briefPattern();  // build the static table now rather than inside the first extract()
+}
+
+// ------------------------------------------------------------------------------------------
+// Quadtree distribution (ORB-SLAM2's DistributeOctTree, re-implemented on index vectors)
+// ------------------------------------------------------------------------------------------
+
+namespace {
+
+struct QuadNode {
+  float x0, y0, x1, y1;     // [x0, x1) x [y0, y1)
+  std::vector<int> idx;     // keypoints inside
+  bool alive = true;
+};
+
+// Splits a node into up to four non-empty children (appended to `out`).
+void splitNode(const QuadNode& n, const std::vector<cv::KeyPoint>& kps, std::vector<QuadNode>& out) {
+  const float hx = std::ceil((n.x1 - n.x0) * 0.5f);
+  const float hy = std::ceil((n.y1 - n.y0) * 0.5f);
+  const float mx = n.x0 + hx, my = n.y0 + hy;
+  QuadNode c[4] = {{n.x0, n.y0, mx, my, {}}, {mx, n.y0, n.x1, my, {}},
+                   {n.x0, my, mx, n.y1, {}}, {mx, my, n.x1, n.y1, {}}};
+  for (QuadNode& ch : c) ch.idx.reserve(n.idx.size());
+  for (int i : n.idx) {
+    const cv::Point2f& p = kps[i].pt;
+    int k = (p.x < mx ? 0 : 1) + (p.y < my ? 0 : 2);
+    c[k].idx.push_back(i);
+  }
+  for (QuadNode& ch : c) {
+    if (!ch.idx.empty()) out.push_back(std::move(ch));
+  }
+}
+
+bool splittable(const QuadNode& n) {
+  return n.idx.size() > 1 && (n.x1 - n.x0 > 1.0f || n.y1 - n.y0 > 1.0f);
+}
+
+// Keeps at most `target` keypoints spread over [x0,x1) x [y0,y1): split the region into
+// quadrants until there are `target` non-empty cells (or no cell can be split), then keep the
+// strongest keypoint of each cell.
+std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kps, float x0,
+                                             float x1, float y0, float y1, int target) {
+  if (target <= 0 || kps.empty()) return {};
+  const float w = x1 - x0, h = y1 - y0;
+  const int n_ini = std::max(1, static_cast<int>(std::lround(w / h)));
+  const float hx = w / n_ini;
+
+  std::vector<QuadNode> nodes(n_ini);
+  for (int i = 0; i < n_ini; ++i) {
+    nodes[i] = {x0 + hx * i, y0, i + 1 == n_ini ? x1 : x0 + hx * (i + 1), y1, {}};
+  }
+  for (int i = 0; i < static_cast<int>(kps.size()); ++i) {
+    int k = std::min(n_ini - 1, std::max(0, static_cast<int>((kps[i].pt.x - x0) / hx)));
+    nodes[k].idx.push_back(i);
+  }
+  nodes.erase(std::remove_if(nodes.begin(), nodes.end(),
+                             [](const QuadNode& n) { return n.idx.empty(); }),
+              nodes.end());
+
+  // Phase 1: split every splittable node per pass while the count stays clearly below target.
+  bool finished = false;
+  int alive = static_cast<int>(nodes.size());
+  while (!finished) {
+    const int prev = alive;
+    std::vector<QuadNode> next;
+    next.reserve(nodes.size() * 4);
+    int n_multi = 0;
+    for (QuadNode& n : nodes) {
+      if (!splittable(n)) {
+        next.push_back(std::move(n));
+        continue;
+      }
+      size_t before = next.size();
+      splitNode(n, kps, next);
+      for (size_t k = before; k < next.size(); ++k) n_multi += next[k].idx.size() > 1 ? 1 : 0;
+    }
+    nodes.swap(next);
+    alive = static_cast<int>(nodes.size());
+    if (alive >= target || alive == prev) {
+      finished = true;
+    } else if (alive + 3 * n_multi > target) {
+      // Phase 2: one more full pass would overshoot, so split the most populated nodes first,
+      // one at a time, and stop as soon as the target is reached.
+      while (!finished) {
+        const int prev2 = alive;
+        std::vector<int> order;
+        for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
+          if (nodes[i].alive && splittable(nodes[i])) order.push_back(i);
+        }
+        std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+          return nodes[a].idx.size() > nodes[b].idx.size();
+        });
+        for (int i : order) {
+          std::vector<QuadNode> children;
+          splitNode(nodes[i], kps, children);
+          nodes[i].alive = false;
+          alive += static_cast<int>(children.size()) - 1;
+          for (QuadNode& c : children) nodes.push_back(std::move(c));
+          if (alive >= target) break;
+        }
+        if (alive >= target || alive == prev2) finished = true;
+      }
+    }
+  }
+
+  std::vector<cv::KeyPoint> out;
+  out.reserve(alive);
+  for (const QuadNode& n : nodes) {
+    if (!n.alive) continue;
+    int best = n.idx[0];
+    for (int i : n.idx) {
+      if (kps[i].response > kps[best].response) best = i;
+    }
+    out.push_back(kps[best]);
+  }
+  // A phase-2 split adds up to 3 nodes at once: trim the overshoot, weakest first.
+  if (static_cast<int>(out.size()) > target) {
+    std::stable_sort(out.begin(), out.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
+      return a.response > b.response;
+    });
+    out.resize(target);
+  }
+  return out;
+}
+
+// Intensity-centroid orientation (Rosin) over the disk of radius 15; degrees in [0, 360).
+float icAngle(const cv::Mat& img, const cv::Point2f& pt, const std::vector<int>& umax) {
+  const int r = static_cast<int>(umax.size()) - 1;
+  const uint8_t* center = img.ptr<uint8_t>(cvRound(pt.y)) + cvRound(pt.x);
+  const int step = static_cast<int>(img.step1());
+  int m01 = 0, m10 = 0;
+  for (int u = -r; u <= r; ++u) m10 += u * center[u];
+  for (int v = 1; v <= r; ++v) {
+    int v_sum = 0;
+    const int d = umax[v];
+    const uint8_t* below = center + v * step;
+    const uint8_t* above = center - v * step;
+    for (int u = -d; u <= d; ++u) {
+      int plus = below[u], minus = above[u];
+      v_sum += plus - minus;
+      m10 += u * (plus + minus);
+    }
+    m01 += v * v_sum;
+  }
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+}
+
+// Rotated BRIEF: the pattern is rotated by the keypoint angle and each bit is the comparison
+// of two blurred pixels.
+void briefDescriptor(const cv::Mat& blurred, const cv::KeyPoint& kp,
+                     const std::vector<cv::Point>& pattern, uint8_t* desc) {
+  const float angle = kp.angle * static_cast<float>(CV_PI / 180.0);
+  const float a = std::cos(angle), b = std::sin(angle);
+  const uint8_t* center = blurred.ptr<uint8_t>(cvRound(kp.pt.y)) + cvRound(kp.pt.x);
+  const int step = static_cast<int>(blurred.step1());
+  auto value = [&](const cv::Point& p) {
+    int x = cvRound(p.x * a - p.y * b);
+    int y = cvRound(p.x * b + p.y * a);
+    return center[y * step + x];
+  };
+  const cv::Point* pp = pattern.data();
+  for (int byte = 0; byte < 32; ++byte) {
+    int val = 0;
+    for (int bit = 0; bit < 8; ++bit, pp += 2) {
+      val |= (value(pp[0]) < value(pp[1]) ? 1 : 0) << bit;
+    }
+    desc[byte] = static_cast<uint8_t>(val);
+  }
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Extraction
+// ------------------------------------------------------------------------------------------
+
+void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints,
+                           cv::Mat& descriptors) const {
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    throw Error("OrbExtractor::extract: expected a non-empty 8-bit single-channel image, got " +
+                std::string(gray.empty() ? "an empty image" : "type " + cv::typeToString(gray.type())) +
+                "; convert to grayscale first (features::buildFeatureFrame does)");
+  }
+  const int n_levels = options_.n_levels;
+  const std::vector<cv::Point>& pattern = briefPattern();
+
+  std::vector<std::vector<cv::KeyPoint>> level_kps(n_levels);
+  std::vector<cv::Mat> pyramid(n_levels);
+  int total = 0;
+
+  for (int level = 0; level < n_levels; ++level) {
+    if (level == 0) {
+      pyramid[0] = gray;
+    } else {
+      cv::Size sz(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
+                  static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
+      if (sz.width <= 2 * kEdgeThreshold + 2 || sz.height <= 2 * kEdgeThreshold + 2) break;
+      cv::resize(pyramid[level - 1], pyramid[level], sz, 0, 0, cv::INTER_LINEAR);
+    }
+    const cv::Mat& img = pyramid[level];
+    if (features_per_level_[level] <= 0) continue;
+
+    // FAST search area as in ORB-SLAM2: 16 px margins plus FAST's own 3 px radius keep every
+    // keypoint >= 19 px from the border, far enough for the rotated 31 px patch and the blur.
+    const int min_x = kEdgeThreshold - 3, min_y = kEdgeThreshold - 3;
+    const int max_x = img.cols - kEdgeThreshold + 3, max_y = img.rows - kEdgeThreshold + 3;
+    const int w = max_x - min_x, h = max_y - min_y;
+    if (w <= 2 * 3 + 1 || h <= 2 * 3 + 1) continue;
+    const cv::Mat area = img(cv::Rect(min_x, min_y, w, h));
+
+    // One FAST pass over the whole area at the initial threshold gives exactly what per-cell
+    // calls would (minus duplicates from overlapping cells); cells left empty are searched again
+    // with the fallback threshold, each on its own window so that weak corners only fill holes.
+    const int n_cols = std::max(1, w / kCellSize), n_rows = std::max(1, h / kCellSize);
+    const int cell_w = (w + n_cols - 1) / n_cols, cell_h = (h + n_rows - 1) / n_rows;
+    std::vector<cv::KeyPoint> found;
+    cv::FAST(area, found, options_.ini_th_fast, true);
+    std::vector<uint8_t> occupied(n_cols * n_rows, 0);
+    for (const cv::KeyPoint& kp : found) {
+      int cx = std::min(n_cols - 1, static_cast<int>(kp.pt.x) / cell_w);
+      int cy = std::min(n_rows - 1, static_cast<int>(kp.pt.y) / cell_h);
+      occupied[cy * n_cols + cx] = 1;
+    }
+    std::vector<cv::KeyPoint> weak;
+    for (int cy = 0; cy < n_rows; ++cy) {
+      for (int cx = 0; cx < n_cols; ++cx) {
+        if (occupied[cy * n_cols + cx]) continue;
+        const int x0 = cx * cell_w, y0 = cy * cell_h;
+        const int x1 = std::min(w, x0 + cell_w), y1 = std::min(h, y0 + cell_h);
+        if (x1 <= x0 || y1 <= y0) continue;
+        // Window grown by FAST's 3 px radius so corners on the cell's own pixels are testable.
+        const int wx0 = std::max(0, x0 - 3), wy0 = std::max(0, y0 - 3);
+        const int wx1 = std::min(w, x1 + 3), wy1 = std::min(h, y1 + 3);
+        weak.clear();
+        cv::FAST(area(cv::Rect(wx0, wy0, wx1 - wx0, wy1 - wy0)), weak, options_.min_th_fast, true);
+        for (cv::KeyPoint kp : weak) {
+          kp.pt.x += wx0;
+          kp.pt.y += wy0;
+          if (kp.pt.x >= x0 && kp.pt.x < x1 && kp.pt.y >= y0 && kp.pt.y < y1) found.push_back(kp);
+        }
+      }
+    }
+    for (cv::KeyPoint& kp : found) {
+      kp.pt.x += min_x;
+      kp.pt.y += min_y;
+    }
+
+    std::vector<cv::KeyPoint> kept =
+        distributeQuadtree(found, static_cast<float>(min_x), static_cast<float>(max_x),
+                           static_cast<float>(min_y), static_cast<float>(max_y),
+                           features_per_level_[level]);
+    const float size = static_cast<float>(kPatchSize * scale_factors_[level]);
+    for (cv::KeyPoint& kp : kept) {
+      kp.octave = level;
+      kp.size = size;
+      kp.angle = icAngle(img, kp.pt, umax_);
+      kp.class_id = -1;
+    }
+    total += static_cast<int>(kept.size());
+    level_kps[level] = std::move(kept);
+  }
+
+  keypoints.clear();
+  keypoints.reserve(total);
+  descriptors.create(total, 32, CV_8U);
+  int row = 0;
+  cv::Mat blurred;
+  for (int level = 0; level < n_levels; ++level) {
+    std::vector<cv::KeyPoint>& kps = level_kps[level];
+    if (kps.empty()) continue;
+    // Descriptors on a smoothed image (7x7, sigma 2) as ORB-SLAM2: BRIEF is noise sensitive.
+    cv::GaussianBlur(pyramid[level], blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    const float scale = static_cast<float>(scale_factors_[level]);
+    for (cv::KeyPoint& kp : kps) {
+      briefDescriptor(blurred, kp, pattern, descriptors.ptr<uint8_t>(row++));
+      if (level != 0) kp.pt *= scale;
+      keypoints.push_back(kp);
+    }
+  }
+}
+
+}  // namespace features
+}  // namespace yolo_slam
