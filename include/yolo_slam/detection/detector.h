@@ -1,0 +1,74 @@
+#pragma once
+// Person (dynamic object) detection on the CPU through OpenCV DNN: Darknet YOLO models
+// (cfg + weights, e.g. the paper's Darknet19-YOLOv3 in models/darknet19-yolov3.cfg) and ONNX
+// models (YOLO-style rows or NanoDet heads).
+#include "yolo_slam/detection/box.h"
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace yolo_slam {
+
+class Config;
+
+namespace detection {
+
+// Model used when none is configured: env YOLO_SLAM_MODEL if set, else
+// sharedDir()/models/mnv2-yolov3-nano-voc.
+std::string defaultModelPath();
+
+struct DetectorOptions {
+  // A model folder (holding one .cfg + .weights, or one .onnx, and one .names file), a .cfg
+  // (weights and names are looked up beside it) or a .onnx file.
+  std::string model = defaultModelPath();
+  int input_width = 0, input_height = 0;  // 0 = the model's native size
+  bool letterbox = false;                 // keep aspect ratio with padding instead of stretching
+  float conf_threshold = 0.3f;
+  float nms_threshold = 0.45f;
+  int threads = 2;                        // cv::setNumThreads for the forward pass
+  std::vector<std::string> dynamic_classes{"person"};  // class names kept (from the names file)
+
+  // Keys: Detector.model, Detector.inputWidth, Detector.inputHeight, Detector.letterbox,
+  // Detector.confThreshold, Detector.nmsThreshold, Detector.threads, Detector.dynamicClasses.
+  // Throws yolo_slam::Error naming the key on out-of-range values.
+  static DetectorOptions load(const Config& cfg);
+};
+
+class Detector {
+ public:
+  virtual ~Detector();
+  // Boxes of the dynamic classes in `bgr` (CV_8UC3 BGR; grey or BGRA are converted), in pixels
+  // clipped to the image, sorted by decreasing score.
+  virtual Boxes detect(const cv::Mat& bgr) = 0;
+};
+
+// Thread-compatible, not thread-safe: one instance may be used by one thread at a time (the
+// cv::dnn::Net inside keeps per-forward state). Use one instance per thread to run in parallel.
+class YoloDetector : public Detector {
+ public:
+  // Loads and checks the model (one warm-up forward pass). Throws yolo_slam::Error naming the
+  // file when a model file is missing, corrupt, or does not match its names file.
+  explicit YoloDetector(const DetectorOptions& options);
+  ~YoloDetector() override;
+  YoloDetector(const YoloDetector&) = delete;
+  YoloDetector& operator=(const YoloDetector&) = delete;
+
+  Boxes detect(const cv::Mat& bgr) override;
+
+  const DetectorOptions& options() const;
+  cv::Size inputSize() const;                     // network input actually used
+  const std::vector<std::string>& classNames() const;
+  std::string description() const;               // e.g. "darknet-yolo 320x320, 20 classes"
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+std::unique_ptr<Detector> makeDetector(const DetectorOptions& options);
+
+}  // namespace detection
+}  // namespace yolo_slam

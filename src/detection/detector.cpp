@@ -1,0 +1,260 @@
+#include "yolo_slam/detection/detector.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/paths.h"
+#include "yolo_slam/detection/decode.h"
+#include "yolo_slam/detection/model_files.h"
+
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cstdlib>
+#include <map>
+
+namespace yolo_slam {
+namespace detection {
+
+std::string defaultModelPath() {
+  const char* env = std::getenv("YOLO_SLAM_MODEL");
+  if (env && *env) return env;
+  return joinPath(sharedDir(), "models/mnv2-yolov3-nano-voc");
+}
+
+DetectorOptions DetectorOptions::load(const Config& cfg) {
+  DetectorOptions o;
+  // Empty keeps the default (YOLO_SLAM_MODEL or the shared model); a relative path is taken
+  // relative to the package folder, like the other files a settings file names.
+  const std::string model = cfg.getString("Detector.model", "");
+  if (!model.empty()) o.model = model.front() == '/' ? model : joinPath(packageDir(), model);
+  o.input_width = cfg.getInt("Detector.inputWidth", o.input_width);
+  o.input_height = cfg.getInt("Detector.inputHeight", o.input_height);
+  o.letterbox = cfg.getBool("Detector.letterbox", o.letterbox);
+  o.conf_threshold = float(cfg.getDouble("Detector.confThreshold", o.conf_threshold));
+  o.nms_threshold = float(cfg.getDouble("Detector.nmsThreshold", o.nms_threshold));
+  o.threads = cfg.getInt("Detector.threads", o.threads);
+  o.dynamic_classes = cfg.getStringList("Detector.dynamicClasses", o.dynamic_classes);
+  const std::string where = cfg.path().empty() ? std::string("settings") : cfg.path();
+  auto bad = [&](const std::string& key, const std::string& why) {
+    throw Error(where + ": key '" + key + "' " + why);
+  };
+  if (o.input_width < 0 || o.input_height < 0 || (o.input_width == 0) != (o.input_height == 0))
+    bad("Detector.inputWidth/inputHeight", "must both be 0 (native size) or both positive");
+  if (o.input_width % 32 || o.input_height % 32)
+    bad("Detector.inputWidth/inputHeight", "must be multiples of 32 (the largest YOLO stride)");
+  if (!(o.conf_threshold > 0 && o.conf_threshold < 1)) bad("Detector.confThreshold", "must be in (0,1)");
+  if (!(o.nms_threshold > 0 && o.nms_threshold <= 1)) bad("Detector.nmsThreshold", "must be in (0,1]");
+  if (o.threads < 1) bad("Detector.threads", "must be at least 1");
+  if (o.dynamic_classes.empty()) bad("Detector.dynamicClasses", "must list at least one class name");
+  return o;
+}
+
+Detector::~Detector() = default;
+
+namespace {
+
+enum class Head { DarknetYolo, OnnxYolo, NanoDet };
+
+const char* headName(Head h) {
+  switch (h) {
+    case Head::DarknetYolo: return "darknet-yolo";
+    case Head::OnnxYolo: return "onnx-yolo";
+    case Head::NanoDet: return "onnx-nanodet";
+  }
+  return "?";
+}
+
+int lastDim(const cv::Mat& m) { return m.size[m.dims - 1]; }
+int rowCount(const cv::Mat& m) { return int(m.total() / lastDim(m)); }
+
+}  // namespace
+
+struct YoloDetector::Impl {
+  DetectorOptions opt;
+  ModelFiles files;
+  std::vector<std::string> names;
+  std::vector<bool> keep;
+  cv::dnn::Net net;
+  cv::Size input;
+  Head head = Head::DarknetYolo;
+  std::vector<std::string> out_names;
+  // NanoDet: (cls output index, reg output index, stride) per level, paired by shape because
+  // some exports name their outputs inconsistently with their contents.
+  struct Level { int cls, reg, stride; };
+  std::vector<Level> levels;
+
+  std::string modelFile() const {
+    return files.format == ModelFormat::Darknet ? files.cfg + " + " + files.weights : files.weights;
+  }
+
+  cv::Mat blob(const cv::Mat& fitted) const {
+    if (head == Head::NanoDet) {
+      // NanoDet expects BGR normalised by its ImageNet mean/std (in 0..255 units).
+      cv::Mat f;
+      fitted.convertTo(f, CV_32F);
+      f -= cv::Scalar(103.53, 116.28, 123.675);
+      cv::multiply(f, cv::Scalar(1 / 57.375, 1 / 57.12, 1 / 58.395), f);
+      return cv::dnn::blobFromImage(f, 1.0, input, cv::Scalar(), false, false);
+    }
+    return cv::dnn::blobFromImage(fitted, 1 / 255.0, input, cv::Scalar(), true, false);
+  }
+
+  void setThreads() const {
+    if (cv::getNumThreads() != opt.threads) cv::setNumThreads(opt.threads);
+  }
+
+  // Runs one forward pass on a grey frame and picks the decoder from the output shapes.
+  void inspectOutputs() {
+    cv::Mat grey(input, CV_8UC3, cv::Scalar::all(114));
+    std::vector<cv::Mat> outs;
+    net.setInput(blob(grey));
+    net.forward(outs, out_names);
+    const int n_cls = int(names.size());
+    bool all_rows = !outs.empty();
+    for (const auto& o : outs) all_rows = all_rows && lastDim(o) == 5 + n_cls;
+    if (files.format == ModelFormat::Darknet) {
+      for (const auto& o : outs)
+        if (lastDim(o) != 5 + n_cls)
+          throw Error("Darknet model " + files.cfg + " predicts " + std::to_string(lastDim(o) - 5) +
+                      " classes but names file " + files.names + " lists " + std::to_string(n_cls) +
+                      "; use the names file that belongs to this model");
+      head = Head::DarknetYolo;
+      return;
+    }
+    if (all_rows) {
+      head = Head::OnnxYolo;
+      return;
+    }
+    // NanoDet: pairs (cells x C scores, cells x 4*bins distances) with equal cell counts.
+    std::map<int, std::vector<int>> by_rows;
+    for (int i = 0; i < int(outs.size()); ++i) by_rows[rowCount(outs[i])].push_back(i);
+    levels.clear();
+    for (const auto& [cells, idx] : by_rows) {
+      if (idx.size() != 2) break;
+      int a = idx[0], b = idx[1];
+      if (lastDim(outs[a]) != n_cls) std::swap(a, b);
+      if (lastDim(outs[a]) != n_cls || lastDim(outs[b]) % 4 != 0) break;
+      int stride = 0;
+      for (int s = 4; s <= 256 && !stride; s *= 2)
+        if (((input.width + s - 1) / s) * ((input.height + s - 1) / s) == cells) stride = s;
+      if (!stride) break;
+      levels.push_back({a, b, stride});
+    }
+    if (levels.empty() || levels.size() * 2 != outs.size()) {
+      std::string shapes;
+      for (const auto& o : outs)
+        shapes += " " + std::to_string(rowCount(o)) + "x" + std::to_string(lastDim(o));
+      throw Error("ONNX model " + files.weights + ": output layout" + shapes +
+                  " is neither YOLO rows (5+" + std::to_string(n_cls) + " columns, from " +
+                  files.names + ") nor a NanoDet head; use a supported model");
+    }
+    head = Head::NanoDet;
+  }
+};
+
+YoloDetector::YoloDetector(const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.opt = options;
+  if (m.opt.threads < 1) throw Error("Detector.threads must be at least 1");
+  m.files = resolveModel(options.model);
+  m.names = readClassNames(m.files.names);
+  m.keep.assign(m.names.size(), false);
+  std::string listed;
+  for (const auto& want : options.dynamic_classes) {
+    listed += (listed.empty() ? "" : ", ") + want;
+    for (size_t c = 0; c < m.names.size(); ++c)
+      if (m.names[c] == want) m.keep[c] = true;
+  }
+  if (std::find(m.keep.begin(), m.keep.end(), true) == m.keep.end()) {
+    std::string have;
+    for (const auto& n : m.names) have += (have.empty() ? "" : ", ") + n;
+    if (have.size() > 200) have = have.substr(0, 200) + "...";
+    throw Error("none of the dynamic classes [" + listed + "] is in names file " + m.files.names +
+                " (" + have + "); set Detector.dynamicClasses to names from that file");
+  }
+
+  if (options.input_width > 0 && options.input_height > 0) {
+    m.input = {options.input_width, options.input_height};
+  } else if (m.files.format == ModelFormat::Darknet) {
+    m.input = darknetInputSize(m.files.cfg);
+  } else {
+    m.input = onnxInputSize(m.files.weights);
+    if (m.input.area() == 0)
+      throw Error("ONNX model " + m.files.weights + " has no fixed input size; set "
+                  "Detector.inputWidth and Detector.inputHeight");
+  }
+
+  m.setThreads();
+  try {
+    m.net = m.files.format == ModelFormat::Darknet
+                ? cv::dnn::readNetFromDarknet(m.files.cfg, m.files.weights)
+                : cv::dnn::readNetFromONNX(m.files.weights);
+    if (m.net.empty()) throw cv::Exception(0, "empty network", "", "", 0);
+    m.net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    m.net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    m.out_names = m.net.getUnconnectedOutLayersNames();
+    m.inspectOutputs();
+  } catch (const cv::Exception& e) {
+    std::string why = e.err.empty() ? e.what() : e.err;
+    throw Error("cannot load detection model " + m.modelFile() + " at input " +
+                std::to_string(m.input.width) + "x" + std::to_string(m.input.height) + " (" +
+                why + "); the file is corrupt, truncated or does not match; re-download it or "
+                "point Detector.model / YOLO_SLAM_MODEL at a valid model");
+  }
+}
+
+YoloDetector::~YoloDetector() = default;
+
+Boxes YoloDetector::detect(const cv::Mat& image) {
+  Impl& m = *impl_;
+  if (image.empty()) throw Error("YoloDetector::detect: empty image");
+  cv::Mat bgr;
+  if (image.depth() != CV_8U)
+    throw Error("YoloDetector::detect: image must be 8-bit (got depth " +
+                std::to_string(image.depth()) + ")");
+  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  else if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+  else if (image.channels() == 3) bgr = image;
+  else throw Error("YoloDetector::detect: image must have 1, 3 or 4 channels");
+
+  m.setThreads();
+  const InputTransform t = InputTransform::make(bgr.size(), m.input, m.opt.letterbox);
+  m.net.setInput(m.blob(fitToInput(bgr, m.input, t)));
+  std::vector<cv::Mat> outs;
+  m.net.forward(outs, m.out_names);
+
+  std::vector<Candidate> cands;
+  const float conf = m.opt.conf_threshold;
+  switch (m.head) {
+    case Head::DarknetYolo:
+      for (const auto& o : outs) decodeYoloRows(o, m.input, true, true, m.keep, conf, cands);
+      break;
+    case Head::OnnxYolo:
+      for (const auto& o : outs) decodeYoloRows(o, m.input, false, false, m.keep, conf, cands);
+      break;
+    case Head::NanoDet:
+      for (const auto& l : m.levels)
+        decodeNanoDetLevel(outs[l.cls], outs[l.reg], l.stride, m.input, m.keep, conf, cands);
+      break;
+  }
+  return suppressAndMap(cands, conf, m.opt.nms_threshold, t, bgr.size(), m.names);
+}
+
+const DetectorOptions& YoloDetector::options() const { return impl_->opt; }
+cv::Size YoloDetector::inputSize() const { return impl_->input; }
+const std::vector<std::string>& YoloDetector::classNames() const { return impl_->names; }
+
+std::string YoloDetector::description() const {
+  return std::string(headName(impl_->head)) + " " + std::to_string(impl_->input.width) + "x" +
+         std::to_string(impl_->input.height) + ", " + std::to_string(impl_->names.size()) +
+         " classes, " + impl_->modelFile();
+}
+
+std::unique_ptr<Detector> makeDetector(const DetectorOptions& options) {
+  return std::make_unique<YoloDetector>(options);
+}
+
+}  // namespace detection
+}  // namespace yolo_slam

@@ -1,0 +1,161 @@
+// yolo_slam_detect: runs the person detector on images and prints the boxes (text or JSON),
+// optionally drawing them to PNG files.
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/json.h"
+#include "yolo_slam/common/paths.h"
+#include "yolo_slam/detection/detector.h"
+#include "yolo_slam/detection/draw.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace yolo_slam;
+
+namespace {
+
+const char* kUsage =
+    "usage: yolo_slam_detect [--model DIR_OR_CFG_OR_ONNX] [--json] [--draw OUT.png | --draw-dir DIR]\n"
+    "                        [--conf T] [--nms T] [--size WxH] [--letterbox] [--threads N]\n"
+    "                        [--classes a,b,...] IMAGE...\n"
+    "Prints the boxes of the dynamic classes (default: person) found in each image.\n"
+    "  --model      model folder, .cfg or .onnx (default: $YOLO_SLAM_MODEL, else\n"
+    "               <shared>/models/mnv2-yolov3-nano-voc)\n"
+    "  --json       print [{\"image\":..,\"boxes\":[{\"class\",\"score\",\"x1\",\"y1\",\"x2\",\"y2\"}]}]\n"
+    "  --draw       write the boxes drawn on the image to OUT.png (one image only)\n"
+    "  --draw-dir   write <DIR>/<image name>.png for every image\n"
+    "  --conf/--nms confidence (0.3) and NMS IoU (0.45) thresholds\n"
+    "  --size       network input size, multiple of 32 (default: the model's own)\n";
+
+std::string baseName(const std::string& path) {
+  size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  size_t dot = name.find_last_of('.');
+  return dot == std::string::npos ? name : name.substr(0, dot);
+}
+
+float parseFloat(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  float f = std::strtof(v.c_str(), &end);
+  if (v.empty() || *end) throw Error(flag + " needs a number, got '" + v + "'");
+  return f;
+}
+
+int run(int argc, char** argv) {
+  detection::DetectorOptions opt;
+  bool json = false;
+  std::string draw, draw_dir;
+  std::vector<std::string> images;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw Error(a + " needs a value (see --help)");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::cout << kUsage;
+      return 0;
+    } else if (a == "--model") {
+      opt.model = value();
+    } else if (a == "--json") {
+      json = true;
+    } else if (a == "--draw") {
+      draw = value();
+    } else if (a == "--draw-dir") {
+      draw_dir = value();
+    } else if (a == "--conf") {
+      opt.conf_threshold = parseFloat(a, value());
+    } else if (a == "--nms") {
+      opt.nms_threshold = parseFloat(a, value());
+    } else if (a == "--threads") {
+      opt.threads = int(parseFloat(a, value()));
+    } else if (a == "--letterbox") {
+      opt.letterbox = true;
+    } else if (a == "--size") {
+      std::string v = value();
+      if (std::sscanf(v.c_str(), "%dx%d", &opt.input_width, &opt.input_height) != 2)
+        throw Error("--size needs WxH, e.g. 416x416, got '" + v + "'");
+    } else if (a == "--classes") {
+      std::string v = value();
+      opt.dynamic_classes.clear();
+      size_t start = 0;
+      while (start <= v.size()) {
+        size_t comma = v.find(',', start);
+        std::string c = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        if (!c.empty()) opt.dynamic_classes.push_back(c);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
+    } else if (!a.empty() && a[0] == '-') {
+      throw Error("unknown option " + a + " (see --help)");
+    } else {
+      images.push_back(a);
+    }
+  }
+  if (images.empty()) {
+    std::cerr << kUsage;
+    return 1;
+  }
+  if (!draw.empty() && images.size() != 1)
+    throw Error("--draw takes one image; use --draw-dir DIR for several");
+  if (!(opt.conf_threshold > 0 && opt.conf_threshold < 1)) throw Error("--conf must be in (0,1)");
+  if (!(opt.nms_threshold > 0 && opt.nms_threshold <= 1)) throw Error("--nms must be in (0,1]");
+  if (opt.threads < 1) throw Error("--threads must be at least 1");
+  if ((opt.input_width % 32) || (opt.input_height % 32) || opt.input_width < 0 || opt.input_height < 0)
+    throw Error("--size must be positive multiples of 32");
+  if (!draw_dir.empty() && !dirExists(draw_dir))
+    throw Error("--draw-dir " + draw_dir + " is not an existing folder; create it first");
+
+  detection::YoloDetector detector(opt);
+  if (!json) std::cout << "# model: " << detector.description() << "\n";
+  if (json) std::cout << "[";
+  for (size_t i = 0; i < images.size(); ++i) {
+    cv::Mat img = cv::imread(images[i], cv::IMREAD_COLOR);
+    if (img.empty()) throw Error("cannot read image " + images[i] + "; check the path and format");
+    detection::Boxes boxes = detector.detect(img);
+    if (json) {
+      std::cout << (i ? ",\n " : "") << "{\"image\":\"" << jsonEscape(images[i])
+                << "\",\"boxes\":" << detection::boxesJson(boxes) << "}";
+    } else {
+      std::cout << images[i] << ": " << boxes.size() << " box(es)\n";
+      for (const auto& b : boxes) {
+        char line[256];
+        std::snprintf(line, sizeof(line), "  %s %.3f  x1=%.1f y1=%.1f x2=%.1f y2=%.1f\n",
+                      b.label.c_str(), b.score, b.rect.x, b.rect.y, b.rect.x + b.rect.width,
+                      b.rect.y + b.rect.height);
+        std::cout << line;
+      }
+    }
+    std::string out = !draw.empty() ? draw
+                      : !draw_dir.empty() ? joinPath(draw_dir, baseName(images[i]) + ".png")
+                                          : "";
+    if (!out.empty()) {
+      detection::drawBoxes(img, boxes);
+      bool ok = false;
+      try {
+        ok = cv::imwrite(out, img);
+      } catch (const cv::Exception&) {
+        ok = false;
+      }
+      if (!ok) throw Error("cannot write " + out + "; check the folder exists and the name ends in .png");
+    }
+  }
+  if (json) std::cout << "]\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cout.flush();
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+}
