@@ -186,6 +186,7 @@ YoloDetector::YoloDetector(const DetectorOptions& options) : impl_(std::make_uni
                   "Detector.inputWidth and Detector.inputHeight");
   }
 
+  if (m.files.format == ModelFormat::Darknet) checkDarknetWeights(m.files.cfg, m.files.weights);
   m.setThreads();
   try {
     m.net = m.files.format == ModelFormat::Darknet

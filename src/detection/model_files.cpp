@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -189,6 +191,108 @@ cv::Size darknetInputSize(const std::string& cfg_path) {
     throw Error(cfg_path + ": [net] lacks width/height; add them or set Detector.inputWidth/"
                 "inputHeight");
   return {w, h};
+}
+
+namespace {
+
+struct CfgSection {
+  std::string type;
+  int line = 0;
+  std::map<std::string, std::string> kv;
+};
+
+std::vector<CfgSection> readCfg(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot read Darknet cfg " + path + "; check the model path");
+  std::vector<CfgSection> out;
+  std::string line;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    line = trim(line.substr(0, line.find_first_of("#;")));
+    if (line.empty()) continue;
+    if (line.front() == '[') {
+      out.push_back({line, lineno, {}});
+      continue;
+    }
+    size_t eq = line.find('=');
+    if (eq == std::string::npos || out.empty())
+      throw Error(path + ":" + std::to_string(lineno) + ": expected key=value inside a [section]");
+    out.back().kv[trim(line.substr(0, eq))] = trim(line.substr(eq + 1));
+  }
+  return out;
+}
+
+int cfgInt(const std::string& path, const CfgSection& s, const std::string& key, int def) {
+  auto it = s.kv.find(key);
+  if (it == s.kv.end()) return def;
+  char* end = nullptr;
+  long v = std::strtol(it->second.c_str(), &end, 10);
+  if (it->second.empty() || *end)
+    throw Error(path + ": section " + s.type + " at line " + std::to_string(s.line) + ": " +
+                key + " must be an integer");
+  return int(v);
+}
+
+}  // namespace
+
+long long darknetParamCount(const std::string& path) {
+  auto sections = readCfg(path);
+  if (sections.empty() || (sections[0].type != "[net]" && sections[0].type != "[network]"))
+    throw Error(path + ": first section must be [net]; is this a Darknet cfg?");
+  std::vector<int> channels;  // output channels per layer
+  int c = cfgInt(path, sections[0], "channels", 3);
+  long long total = 0;
+  for (size_t i = 1; i < sections.size(); ++i) {
+    const CfgSection& s = sections[i];
+    const std::string at = path + ":" + std::to_string(s.line) + ": ";
+    if (s.type == "[convolutional]" || s.type == "[conv]") {
+      int f = cfgInt(path, s, "filters", 1), k = cfgInt(path, s, "size", 1);
+      int g = cfgInt(path, s, "groups", 1);
+      bool bn = cfgInt(path, s, "batch_normalize", 0) != 0;
+      if (f <= 0 || k <= 0 || g <= 0 || c % g) throw Error(at + "bad filters/size/groups");
+      total += f + (bn ? 3LL * f : 0LL) + 1LL * f * (c / g) * k * k;
+      c = f;
+    } else if (s.type == "[route]") {
+      auto it = s.kv.find("layers");
+      if (it == s.kv.end()) throw Error(at + "[route] needs layers=");
+      std::stringstream ss(it->second);
+      std::string tok;
+      int sum = 0;
+      const int here = int(channels.size());
+      while (std::getline(ss, tok, ',')) {
+        int l = std::atoi(trim(tok).c_str());
+        int idx = l < 0 ? here + l : l;
+        if (idx < 0 || idx >= here) throw Error(at + "route layer " + tok + " out of range");
+        sum += channels[idx];
+      }
+      c = sum / std::max(1, cfgInt(path, s, "groups", 1));
+    } else if (s.type != "[maxpool]" && s.type != "[upsample]" && s.type != "[shortcut]" &&
+               s.type != "[dropout]" && s.type != "[yolo]" && s.type != "[region]" &&
+               s.type != "[avgpool]") {
+      throw Error(at + "layer type " + s.type + " is not supported by the weights check");
+    }
+    channels.push_back(c);
+  }
+  return total;
+}
+
+void checkDarknetWeights(const std::string& cfg_path, const std::string& weights_path) {
+  std::ifstream in(weights_path, std::ios::binary | std::ios::ate);
+  if (!in) throw Error("cannot read Darknet weights " + weights_path + "; check the model path");
+  const long long size = static_cast<long long>(in.tellg());
+  in.seekg(0);
+  int32_t ver[3] = {0, 0, 0};
+  if (!in.read(reinterpret_cast<char*>(ver), sizeof(ver)))
+    throw Error("Darknet weights " + weights_path + " is truncated (no header); re-download it");
+  // Darknet >= 0.2 stores `seen` as uint64, older files as uint32.
+  const long long header = 12 + ((ver[0] * 10 + ver[1]) >= 2 ? 8 : 4);
+  const long long want = header + 4 * darknetParamCount(cfg_path);
+  if (size != want)
+    throw Error("Darknet weights " + weights_path + " has " + std::to_string(size) +
+                " bytes but " + cfg_path + " needs " + std::to_string(want) + " (" +
+                (size < want ? "truncated" : "weights of a different network") +
+                "); re-download the weights or use the cfg they were trained with");
 }
 
 cv::Size onnxInputSize(const std::string& onnx_path) {

@@ -28,6 +28,15 @@ std::vector<std::string> readClassNames(const std::string& path);
 // [net] width/height of a Darknet cfg; Error naming file:line when absent or malformed.
 cv::Size darknetInputSize(const std::string& cfg_path);
 
+// Number of float parameters a Darknet .weights file holds for this cfg (convolutional layers
+// with groups and batch norm; maxpool/route/shortcut/upsample/dropout/yolo have none). Error
+// naming file:line for a layer type it does not know or a malformed value.
+long long darknetParamCount(const std::string& cfg_path);
+
+// Throws Error naming the weights file when its size is not header + 4 * darknetParamCount()
+// (OpenCV reads truncated or mismatched weights silently).
+void checkDarknetWeights(const std::string& cfg_path, const std::string& weights_path);
+
 // Fixed input size (W x H) of the first non-initializer graph input of an ONNX file, read from
 // its protobuf; (0,0) when the size is symbolic. Error if the file is not a readable ONNX model.
 cv::Size onnxInputSize(const std::string& onnx_path);
