@@ -1,0 +1,87 @@
+#include "yolo_slam/eval/ate.h"
+
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/io/association.h"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+
+namespace yolo_slam {
+namespace eval {
+
+Pose alignRigid(const std::vector<Eigen::Vector3d>& model, const std::vector<Eigen::Vector3d>& data) {
+  if (model.size() != data.size()) throw Error("alignRigid: point sets differ in size");
+  if (model.size() < 2) throw Error("alignRigid: need at least 2 point pairs to align");
+  const double n = static_cast<double>(model.size());
+  Eigen::Vector3d mu_m = Eigen::Vector3d::Zero(), mu_d = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < model.size(); ++k) {
+    mu_m += model[k];
+    mu_d += data[k];
+  }
+  mu_m /= n;
+  mu_d /= n;
+  // M = sum (data - mu_d)(model - mu_m)^T = U D V^T; R = U S V^T maximises trace(R^T M).
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < model.size(); ++k) M += (data[k] - mu_d) * (model[k] - mu_m).transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  // A reflection would fit better when the points are (nearly) planar or noisy; flip the
+  // direction of the smallest singular value to get a proper rotation.
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) S(2, 2) = -1;
+  Pose T = Pose::Identity();
+  T.linear() = svd.matrixU() * S * svd.matrixV().transpose();
+  T.translation() = mu_d - T.linear() * mu_m;
+  return T;
+}
+
+Trajectory uniqueByStamp(const Trajectory& traj) {
+  Trajectory t = traj;
+  std::stable_sort(t.begin(), t.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+  Trajectory out;
+  for (const StampedPose& p : t) {
+    if (!out.empty() && out.back().stamp == p.stamp) {
+      out.back() = p;  // later line overrides, as a Python dict does
+    } else {
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double max_diff,
+                     double offset) {
+  if (gt_in.empty()) throw Error("ATE: the ground-truth trajectory has no poses");
+  if (est_in.empty()) throw Error("ATE: the estimated trajectory has no poses");
+  const Trajectory gt = uniqueByStamp(gt_in);
+  const Trajectory est = uniqueByStamp(est_in);
+  std::vector<double> ta, tb;
+  for (const auto& p : gt) ta.push_back(p.stamp);
+  for (const auto& p : est) tb.push_back(p.stamp);
+  const auto matches = io::associate(ta, tb, offset, max_diff);
+  if (matches.size() < 2) {
+    throw Error("ATE: only " + std::to_string(matches.size()) +
+                " ground-truth/estimate timestamp pairs within " + std::to_string(max_diff) +
+                " s (need >= 2); are these files of the same sequence? (raise --max-diff if the "
+                "clocks differ slightly)");
+  }
+  AteResult r;
+  std::vector<Eigen::Vector3d> est_pos;
+  for (const auto& m : matches) {
+    r.gt_stamps.push_back(gt[m.first].stamp);
+    r.est_stamps.push_back(est[m.second].stamp);
+    r.gt_positions.push_back(gt[m.first].T_wc.translation());
+    est_pos.push_back(est[m.second].T_wc.translation());
+  }
+  r.alignment = alignRigid(est_pos, r.gt_positions);
+  for (size_t k = 0; k < est_pos.size(); ++k) {
+    r.est_aligned.push_back(r.alignment * est_pos[k]);
+    r.errors.push_back((r.est_aligned[k] - r.gt_positions[k]).norm());
+  }
+  r.stats = errorStats(r.errors);
+  return r;
+}
+
+}  // namespace eval
+}  // namespace yolo_slam
