@@ -37,12 +37,12 @@ std::string toString(DynamicMode m) {
 
 ScreeningVariant parseScreeningVariant(const std::string& s) {
   if (s == "paper") return ScreeningVariant::Paper;
-  if (s == "refit") return ScreeningVariant::Refit;
-  throw Error("unknown screening variant '" + s + "'; use paper or refit");
+  if (s == "grow") return ScreeningVariant::Grow;
+  throw Error("unknown screening variant '" + s + "'; use paper or grow");
 }
 
 std::string toString(ScreeningVariant v) {
-  return v == ScreeningVariant::Paper ? "paper" : "refit";
+  return v == ScreeningVariant::Paper ? "paper" : "grow";
 }
 
 void ScreeningOptions::validate(const std::string& where) const {
@@ -54,8 +54,10 @@ void ScreeningOptions::validate(const std::string& where) const {
   if (max_iterations < 1) bad("maxIterations must be >= 1, got " + std::to_string(max_iterations));
   if (!(box_dilation >= 0 && box_dilation <= 1))
     bad("boxDilation must be in [0, 1], got " + std::to_string(box_dilation));
-  if (!(refit_sigma > 0) || !std::isfinite(refit_sigma))
-    bad("refitSigma must be > 0, got " + std::to_string(refit_sigma));
+  if (!(grow_radius_px > 0) || !std::isfinite(grow_radius_px))
+    bad("growRadius must be > 0 (pixels), got " + std::to_string(grow_radius_px));
+  if (!(grow_depth_m > 0) || !std::isfinite(grow_depth_m))
+    bad("growDepth must be > 0 (metres), got " + std::to_string(grow_depth_m));
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
@@ -82,16 +84,19 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   int seed = cfg.getInt("Screening.seed", static_cast<int>(o.seed));
   if (seed < 0) throw Error(file + ": key 'Screening.seed' must be >= 0, got " + std::to_string(seed));
   o.seed = static_cast<unsigned>(seed);
-  std::string nd = cfg.getString("Screening.noDepth", o.no_depth_dynamic ? "dynamic" : "static");
+  std::string nd = cfg.getString("Screening.noDepth", "dynamic");
   if (nd == "dynamic") {
-    o.no_depth_dynamic = true;
+    o.no_depth = NoDepthRule::Dynamic;
   } else if (nd == "static") {
-    o.no_depth_dynamic = false;
+    o.no_depth = NoDepthRule::Static;
+  } else if (nd == "nearest") {
+    o.no_depth = NoDepthRule::Nearest;
   } else {
-    throw Error(file + ": key 'Screening.noDepth' must be dynamic or static, got '" + nd + "'");
+    throw Error(file + ": key 'Screening.noDepth' must be dynamic, static or nearest, got '" + nd + "'");
   }
   o.box_dilation = cfg.getDouble("Screening.boxDilation", o.box_dilation);
-  o.refit_sigma = cfg.getDouble("Screening.refitSigma", o.refit_sigma);
+  o.grow_radius_px = cfg.getDouble("Screening.growRadius", o.grow_radius_px);
+  o.grow_depth_m = cfg.getDouble("Screening.growDepth", o.grow_depth_m);
   o.validate(file + ": Screening.*");
   return o;
 }
@@ -123,7 +128,6 @@ ConsensusResult Screener::depthRansac(const std::vector<float>& depths, unsigned
   // k starts unbounded (paper) and is capped by max_iterations.
   double k = std::numeric_limits<double>::infinity();
   int best_count = 0;
-  double best_mean = 0, best_var = 0;
   std::vector<int> current, best;
   current.reserve(n);
   int iter = 0;
@@ -153,32 +157,37 @@ ConsensusResult Screener::depthRansac(const std::vector<float>& depths, unsigned
     if (count > best_count) {
       best_count = count;
       best.swap(current);
-      best_mean = mean2;
-      best_var = var1;
       k = adaptiveIterations(static_cast<double>(best_count) / n, opt_.probability, 2);
     }
   }
   res.iterations = iter;
 
-  if (opt_.variant == ScreeningVariant::Refit && best_count >= 2) {
-    // Re-estimate the cluster from all its members: centre = consensus mean, half-width =
-    // refit_sigma * consensus std, but never narrower than the model's acceptance interval.
-    double sum = 0, sum2 = 0;
-    for (int i : best) sum += depths[i];
-    const double mu = sum / best_count;
-    for (int i : best) sum2 += (depths[i] - mu) * (depths[i] - mu);
-    const double sd = std::sqrt(sum2 / best_count);
-    // Acceptance interval of the best model: |x - mean2| < sqrt(1.5 * (3 thr - 2 var1)).
-    const double accept = std::sqrt(std::max(0.0, 1.5 * (3.0 * thr - 2.0 * best_var)));
-    const double half = std::max(opt_.refit_sigma * sd, accept);
-    (void)best_mean;
-    best.clear();
-    for (int i = 0; i < n; ++i)
-      if (std::abs(depths[i] - mu) < half) best.push_back(i);
-  }
   std::sort(best.begin(), best.end());
   res.members = std::move(best);
   return res;
+}
+
+void Screener::grow(const std::vector<cv::Point2f>& pts, const std::vector<float>& depths,
+                    std::vector<uint8_t>& member) const {
+  const size_t n = pts.size();
+  const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
+  const float dd = static_cast<float>(opt_.grow_depth_m);
+  std::vector<int> queue;
+  queue.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (member[i]) queue.push_back(static_cast<int>(i));
+  // Breadth-first single linkage from every member; each keypoint enters the queue once.
+  for (size_t q = 0; q < queue.size(); ++q) {
+    const int m = queue[q];
+    for (size_t i = 0; i < n; ++i) {
+      if (member[i]) continue;
+      if (std::abs(depths[i] - depths[m]) >= dd) continue;
+      const float dx = pts[i].x - pts[m].x, dy = pts[i].y - pts[m].y;
+      if (dx * dx + dy * dy >= r2) continue;
+      member[i] = 1;
+      queue.push_back(static_cast<int>(i));
+    }
+  }
 }
 
 namespace {
@@ -215,22 +224,49 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
   members.reserve(n);
   depths.reserve(n);
 
-  // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + r so regions are
-  // independent of each other and of previous frames.
+  // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + 7919 r so regions
+  // are independent of each other and of previous frames.
+  std::vector<cv::Point2f> pts;
+  std::vector<uint8_t> member;
   auto screenRegion = [&](const std::vector<int>& idx, unsigned region) {
     depths.clear();
     members.clear();
+    pts.clear();
     for (int i : idx) {
       if (frame.depth[i] > 0) {
         depths.push_back(frame.depth[i]);
         members.push_back(i);
-      } else if (opt_.no_depth_dynamic) {
-        drop[i] = 1;
+        pts.push_back(frame.keypoints[i].pt);
       }
     }
     ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
     st.iterations += r.iterations;
-    for (int m : r.members) drop[members[m]] = 1;
+    member.assign(depths.size(), 0);
+    for (int m : r.members) member[m] = 1;
+    if (opt_.variant == ScreeningVariant::Grow) grow(pts, depths, member);
+    for (size_t m = 0; m < member.size(); ++m)
+      if (member[m]) drop[members[m]] = 1;
+    if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
+    const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
+    for (int i : idx) {
+      if (frame.depth[i] > 0) continue;
+      if (opt_.no_depth == ScreeningOptions::NoDepthRule::Dynamic) {
+        drop[i] = 1;
+        continue;
+      }
+      // Nearest: copy the label of the closest keypoint with depth within the radius.
+      const cv::Point2f p = frame.keypoints[i].pt;
+      float best = r2;
+      int label = 0;
+      for (size_t m = 0; m < pts.size(); ++m) {
+        const float dx = pts[m].x - p.x, dy = pts[m].y - p.y, d2 = dx * dx + dy * dy;
+        if (d2 < best) {
+          best = d2;
+          label = member[m];
+        }
+      }
+      if (label) drop[i] = 1;
+    }
   };
 
   std::vector<int> idx;
@@ -306,7 +342,7 @@ std::string ScreeningMetrics::toJson() const {
 }
 
 ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,
-                                   const detection::Boxes& boxes) {
+                                   const detection::Boxes& boxes, int ignore_border_px) {
   if (mask.empty() || mask.type() != CV_8UC1)
     throw Error("screening metrics: ground-truth mask must be a non-empty 8-bit single-channel image");
   if (frame.width > 0 && frame.height > 0 &&
@@ -315,12 +351,22 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
                 std::to_string(mask.rows) + " but the image is " + std::to_string(frame.width) +
                 "x" + std::to_string(frame.height) + "; use the mask of this frame");
   }
+  cv::Mat core_dyn, near_dyn;  // mask eroded / dilated by the ignored border
+  if (ignore_border_px > 0) {
+    const cv::Mat k = cv::getStructuringElement(
+        cv::MORPH_ELLIPSE, cv::Size(2 * ignore_border_px + 1, 2 * ignore_border_px + 1));
+    cv::Mat bin = mask > 127;
+    cv::erode(bin, core_dyn, k);
+    cv::dilate(bin, near_dyn, k);
+  }
   ScreeningMetrics m;
   for (size_t i = 0; i < frame.keypoints.size(); ++i) {
     const cv::Point2f& p = frame.keypoints[i].pt;
     const int x = std::min(mask.cols - 1, std::max(0, static_cast<int>(std::lround(p.x))));
     const int y = std::min(mask.rows - 1, std::max(0, static_cast<int>(std::lround(p.y))));
     const bool dyn_gt = mask.at<uint8_t>(y, x) > 127;
+    if (ignore_border_px > 0 && (dyn_gt ? !core_dyn.at<uint8_t>(y, x) : near_dyn.at<uint8_t>(y, x)))
+      continue;
     const bool dropped = i < frame.dynamic.size() && frame.dynamic[i];
     if (dyn_gt) {
       ++m.dynamic_total;

@@ -61,7 +61,7 @@ TEST(AdaptiveIterations, MatchesEquation8) {
 }
 
 TEST(DepthRansac, PersonPlaneInFrontOfWallIsTheConsensus) {
-  for (ScreeningVariant v : {ScreeningVariant::Paper, ScreeningVariant::Refit}) {
+  for (ScreeningVariant v : {ScreeningVariant::Paper, ScreeningVariant::Grow}) {
     ScreeningOptions o;
     o.variant = v;
     o.variance_threshold_m2 = 0.05;
@@ -165,14 +165,14 @@ TEST(Screener, NoDepthRuleAndExistingLabels) {
   s.frame.dynamic[250] = 1;               // propagated label outside any box survives
   ScreeningOptions o;
   o.variance_threshold_m2 = 0.05;
-  o.no_depth_dynamic = true;
+  o.no_depth = ScreeningOptions::NoDepthRule::Dynamic;
   Screener(o).screen(s.frame, s.boxes);
   EXPECT_EQ(s.frame.dynamic[0], 1);
   EXPECT_EQ(s.frame.dynamic[130], 1);
   EXPECT_EQ(s.frame.dynamic[250], 1);
   Scene t = makeScene();
   t.frame.depth[0] = 0;
-  o.no_depth_dynamic = false;
+  o.no_depth = ScreeningOptions::NoDepthRule::Static;
   Screener(o).screen(t.frame, t.boxes);
   EXPECT_EQ(t.frame.dynamic[0], 0);
   EXPECT_EQ(t.frame.dynamic[1], 1);
@@ -198,7 +198,7 @@ TEST(Options, ParseAndLoad) {
   EXPECT_DOUBLE_EQ(o.probability, 0.95);
   EXPECT_EQ(o.max_iterations, 77);
   EXPECT_EQ(o.seed, 5u);
-  EXPECT_FALSE(o.no_depth_dynamic);
+  EXPECT_EQ(o.no_depth, ScreeningOptions::NoDepthRule::Static);
   EXPECT_DOUBLE_EQ(o.box_dilation, 0.05);
 
   ScreeningOptions d = ScreeningOptions::load(Config());
@@ -242,4 +242,85 @@ TEST(Metrics, CountsAgainstMask) {
   EXPECT_NE(m.toJson().find("\"dynamic_recall\":1"), std::string::npos);
   EXPECT_THROW(evaluateScreening(s.frame, cv::Mat(10, 10, CV_8UC1), s.boxes), Error);
   EXPECT_THROW(loadMask("/nonexistent/mask.png"), Error);
+}
+
+TEST(DepthRansac, GrowFollowsAPersonDeeperThanOneWindow) {
+  // A tilted camera sees a standing person's feet deeper than the head: depth 1.5 m at the top
+  // to 2.3 m at the bottom, a 10 x 20 grid of keypoints; a wall at 4 m fills the box sides.
+  features::FeatureFrame f;
+  f.width = 640;
+  f.height = 480;
+  std::vector<bool> person;
+  for (int r = 0; r < 20; ++r) {
+    for (int c = 0; c < 10; ++c) {
+      const float y = 60 + 20 * r;
+      f.keypoints.emplace_back(cv::Point2f(155 + 10 * c, y), 31.f);
+      f.depth.push_back(1.5f + 0.8f * (y - 60) / 380);
+      person.push_back(true);
+    }
+  }
+  for (int i = 0; i < 60; ++i) {
+    f.keypoints.emplace_back(cv::Point2f(i % 2 ? 110 : 270, 60 + 6 * i), 31.f);
+    f.depth.push_back(4.0f);
+    person.push_back(false);
+  }
+  detection::Boxes boxes(1);
+  boxes[0].rect = cv::Rect2f(100, 50, 200, 420);
+  ScreeningOptions o;  // 0.02 m^2: a window of +-0.3 m around a tight pair
+  o.variant = ScreeningVariant::Paper;
+  features::FeatureFrame paper = f;
+  Screener(o).screen(paper, boxes);
+  o.variant = ScreeningVariant::Grow;
+  features::FeatureFrame grown = f;
+  Screener(o).screen(grown, boxes);
+  int paper_person = 0, grow_person = 0, grow_wall = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (person[i]) {
+      paper_person += paper.dynamic[i];
+      grow_person += grown.dynamic[i];
+    } else {
+      grow_wall += grown.dynamic[i];
+    }
+  }
+  EXPECT_LT(paper_person, 180);  // the window covers only part of the 0.8 m span
+  EXPECT_EQ(grow_person, 200);
+  EXPECT_EQ(grow_wall, 0);
+}
+
+TEST(Screener, NearestNoDepthRuleCopiesTheNeighbour) {
+  Scene s = makeScene();
+  // A depth-less keypoint right next to a person keypoint, one next to a wall keypoint.
+  s.frame.keypoints.emplace_back(s.frame.keypoints[0].pt + cv::Point2f(1, 1), 31.f);
+  s.frame.depth.push_back(0.f);
+  s.frame.keypoints.emplace_back(s.frame.keypoints[130].pt + cv::Point2f(1, 1), 31.f);
+  s.frame.depth.push_back(0.f);
+  ScreeningOptions o;
+  o.no_depth = ScreeningOptions::NoDepthRule::Nearest;
+  Screener(o).screen(s.frame, s.boxes);
+  const size_t n = s.frame.size();
+  EXPECT_EQ(s.frame.dynamic[n - 2], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 1], 0);
+}
+
+TEST(Metrics, IgnoredBorderBand) {
+  features::FeatureFrame f;
+  f.width = 100;
+  f.height = 100;
+  cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(40, 0, 20, 100)).setTo(255);
+  for (float x : {50.f, 41.f, 58.f, 37.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
+  f.dynamic = {1, 0, 0, 1, 0};
+  detection::Boxes boxes(1);
+  boxes[0].rect = cv::Rect2f(0, 0, 100, 100);
+  ScreeningMetrics all = evaluateScreening(f, mask, boxes);
+  EXPECT_EQ(all.dynamic_total, 3);
+  EXPECT_EQ(all.dynamic_dropped, 1);
+  EXPECT_EQ(all.static_in_boxes, 2);
+  EXPECT_EQ(all.static_in_boxes_kept, 1);
+  // With a 5 px band, x = 41, 58 (inside, near the edge) and 37 (outside, near) are left out.
+  ScreeningMetrics core = evaluateScreening(f, mask, boxes, 5);
+  EXPECT_EQ(core.dynamic_total, 1);
+  EXPECT_EQ(core.dynamic_dropped, 1);
+  EXPECT_EQ(core.static_in_boxes, 1);
+  EXPECT_EQ(core.static_in_boxes_kept, 1);
 }
