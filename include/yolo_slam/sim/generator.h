@@ -1,0 +1,106 @@
+#pragma once
+// yolo_slam_synth as a library: deterministic TUM-format RGB-D sequences of people moving
+// through a photo-textured room along real or built-in camera trajectories, with per-pixel
+// dynamic masks and per-object boxes as extra ground truth. Tests and benchmarks of other
+// modules generate short sequences with it into a temporary folder.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/geometry.h"
+#include "yolo_slam/sim/camera_path.h"
+#include "yolo_slam/sim/people.h"
+#include "yolo_slam/sim/renderer.h"
+#include "yolo_slam/sim/sensor.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace yolo_slam {
+namespace sim {
+
+struct SynthOptions {
+  std::string preset = "walking_xyz";  // walking_xyz|walking_static|walking_rpy|walking_half|
+                                       // sitting_static|static_xyz|loop
+  unsigned seed = 1;                   // same seed, same bytes
+  int frames = 0;                      // 0: the preset's length; N: the first N frames
+  std::string textures_dir;            // "": defaultTextureDir() with defaultTextureFiles()
+  std::string trajectory;              // "": the preset's; a built-in name or a TUM file
+  std::string walker_video;            // "": defaultWalkerVideo()
+  std::string tum_people_dir;          // "": defaultTumPeopleDir()
+  double fps = 30.0;
+  int threads = 2;                     // frames rendered in parallel by generate()
+  SensorOptions sensor;
+  CameraModel camera;                  // freiburg3 intrinsics, 640x480
+
+  // Synth.preset, Synth.seed, Synth.frames, Synth.textures, Synth.trajectory, Synth.fps,
+  // Synth.threads, plus SensorOptions keys; Camera.* keys if present.
+  static SynthOptions load(const Config& cfg);
+};
+
+// Ground truth of one visible dynamic object in one frame.
+struct ObjectTruth {
+  int id = 0;
+  std::string cls;            // "person" or "box"
+  cv::Rect box;               // bounding box of its visible pixels (x2 = x + width, exclusive)
+  int pixels = 0;             // visible pixels
+  double visible_fraction = 0;  // visible pixels / pixels it would cover unoccluded, unclipped
+};
+
+struct SynthFrame {
+  size_t index = 0;
+  double rgb_stamp = 0, depth_stamp = 0;
+  Pose T_wc = Pose::Identity();
+  cv::Mat bgr;          // CV_8UC3 with sensor noise (as written)
+  cv::Mat depth;        // CV_32F metres after the sensor model (as written, before 16-bit)
+  cv::Mat depth_exact;  // CV_32F metres, exact geometry, 0 = nothing
+  cv::Mat ids;          // CV_16U object id per pixel
+  cv::Mat mask;         // CV_8U 255 = dynamic
+  std::vector<ObjectTruth> objects;
+};
+
+struct PresetInfo {
+  std::string name, motion, description;
+  int frames, walkers, sitters;
+  bool carried_box;
+};
+const std::vector<PresetInfo>& presets();
+
+class SequenceGenerator {
+ public:
+  // Loads textures and people and builds the room. Throws yolo_slam::Error for an unknown
+  // preset, a missing texture folder, video or trajectory file.
+  explicit SequenceGenerator(const SynthOptions& opt);
+  ~SequenceGenerator();
+
+  size_t size() const { return rgb_stamps_.size(); }
+  const CameraModel& camera() const { return opt_.camera; }
+  const SynthOptions& options() const { return opt_; }
+  const std::vector<std::string>& textureFiles() const { return texture_files_; }
+
+  // Renders frame i (thread-safe, independent of the order frames are rendered in).
+  SynthFrame frame(size_t i) const;
+
+  // Writes the sequence into out_dir (created if needed): rgb/, depth/, masks/, rgb.txt,
+  // depth.txt, groundtruth.txt, associations.txt, boxes.txt, camera.yaml. Returns seconds spent.
+  double generate(const std::string& out_dir, bool progress = false) const;
+
+ private:
+  struct Person;
+  std::vector<Quad> dynamicQuads(double t, const Pose& T_wc) const;
+
+  SynthOptions opt_;
+  PresetInfo preset_;
+  std::vector<Texture> textures_;
+  std::vector<std::string> texture_files_;
+  std::vector<Quad> room_;
+  std::unique_ptr<CameraPath> path_;
+  std::unique_ptr<Renderer> renderer_;
+  std::shared_ptr<const std::vector<SpriteTrack>> walkers_, sitters_;
+  std::vector<Person> people_;
+  int box_texture_ = 0;
+  std::vector<double> rgb_stamps_, depth_stamps_;
+  double t0_ = 0;
+};
+
+}  // namespace sim
+}  // namespace yolo_slam

@@ -1,0 +1,536 @@
+#include "yolo_slam/sim/generator.h"
+
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/paths.h"
+#include "yolo_slam/common/progress.h"
+#include "yolo_slam/common/timing.h"
+#include "yolo_slam/io/trajectory.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <sys/stat.h>
+#include <thread>
+
+namespace yolo_slam {
+namespace sim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kBaseStamp = 1700000000.0;  // first rgb stamp (any epoch-like value works)
+
+// World frame of the room: x right, y forward (away from the start view), z up; floor at z = 0.
+const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();
+
+std::string realGroundTruth() {
+  return joinPath(sharedDir(), "data/tum/rgbd_dataset_freiburg3_walking_xyz/groundtruth.txt");
+}
+
+uint64_t mix(uint64_t a, uint64_t b) {
+  uint64_t x = a * 0x9E3779B97F4A7C15ull ^ (b + 0x7F4A7C159E3779B9ull + (a << 6) + (a >> 2));
+  x ^= x >> 31;
+  x *= 0xBF58476D1CE4E5B9ull;
+  x ^= x >> 27;
+  return x ? x : 1;
+}
+
+double round6(double s) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", s);
+  return std::strtod(buf, nullptr);
+}
+std::string stampStr(double s) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", s);
+  return buf;
+}
+
+void makeDir(const std::string& d) {
+  if (dirExists(d)) return;
+  if (::mkdir(d.c_str(), 0755) != 0 && !dirExists(d))
+    throw Error("cannot create folder " + d + ": check the parent exists and is writable");
+}
+
+// Builds the textured room. Textures are assigned round robin with a stride so that
+// neighbouring surfaces get different photographs; each surface shows a crop of its photo with
+// the surface's aspect ratio (no stretching).
+class RoomBuilder {
+ public:
+  RoomBuilder(const std::vector<Texture>& tex, std::vector<Quad>& out) : tex_(tex), out_(out) {}
+
+  int nextTexture() {
+    int t = (int)((counter_ * 7 + 3) % tex_.size());
+    ++counter_;
+    return t;
+  }
+  // Colour grading of the next surfaces: walls pale, floor dark and warm, furniture natural.
+  void grade(float saturation, cv::Vec3f tint) {
+    saturation_ = saturation;
+    tint_ = tint;
+  }
+  void panel(const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev,
+             float bright, int tex = -1, bool two_sided = true) {
+    Quad q;
+    q.saturation = saturation_;
+    q.tint = tint_;
+    q.origin = o;
+    q.edge_u = eu;
+    q.edge_v = ev;
+    q.texture = tex >= 0 ? tex : nextTexture();
+    q.brightness = bright;
+    q.two_sided = two_sided;
+    const Texture& t = tex_[q.texture];
+    double aspect = eu.norm() / ev.norm();
+    double tw = t.width(), th = t.height();
+    if (tw / th > aspect) tw = th * aspect; else th = tw / aspect;
+    q.tex_rect = cv::Rect2f((float)(0.5 * (t.width() - tw)), (float)(0.5 * (t.height() - th)), (float)tw, (float)th);
+    out_.push_back(q);
+  }
+  // A wall or floor split into a grid of panels of at most `cell` metres.
+  void grid(const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev,
+            double cell, float bright, float bright_var) {
+    int nu = std::max(1, (int)std::ceil(eu.norm() / cell - 1e-9));
+    int nv = std::max(1, (int)std::ceil(ev.norm() / cell - 1e-9));
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) {
+        float b = bright * (1.f - bright_var * (float)(((i * 5 + j * 3) % 4) / 3.0));
+        panel(o + eu * ((double)i / nu) + ev * ((double)j / nv), eu / nu, ev / nv, b);
+      }
+  }
+  // Axis-aligned box [lo, hi]: outward faces (the bottom is never seen).
+  void box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, float bright, double cell = 2.0) {
+    Eigen::Vector3d d = hi - lo;
+    Eigen::Vector3d X(d.x(), 0, 0), Y(0, d.y(), 0), Z(0, 0, d.z());
+    auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev, float b) {
+      if (eu.norm() > cell || ev.norm() > cell) grid(o, eu, ev, cell, b, 0.f);
+      else panel(o, eu, ev, b, -1, false);
+    };
+    face(lo, X, Z, bright);                        // -y face (normal X x Z = -y)
+    face(lo + Y + X, -X, Z, bright);               // +y face
+    face(lo + Y, -Y, Z, bright * 0.9f);            // -x face
+    face(lo + X, Y, Z, bright * 0.9f);             // +x face
+    face(lo + Z, X, Y, bright * 1.05f);            // top (normal +z)
+  }
+
+ private:
+  const std::vector<Texture>& tex_;
+  std::vector<Quad>& out_;
+  size_t counter_ = 0;
+  float saturation_ = 1.f;
+  cv::Vec3f tint_{1.f, 1.f, 1.f};
+};
+
+void buildRoom(const std::vector<Texture>& tex, std::vector<Quad>& q) {
+  RoomBuilder b(tex, q);
+  using V = Eigen::Vector3d;
+  const double x0 = -3.5, x1 = 3.5, y0 = -2.5, y1 = 5.2, h = 2.8;
+  // Floor: dark warm carpet tiles; ceiling: pale panels; walls: pale, low-saturation panels
+  // (photographs graded like painted or papered walls); furniture keeps natural colours.
+  b.grade(0.25f, cv::Vec3f(0.55f, 0.68f, 0.8f));
+  b.grid(V(x0, y0, 0), V(x1 - x0, 0, 0), V(0, y1 - y0, 0), 1.9, 1.0f, 0.1f);
+  b.grade(0.1f, cv::Vec3f(1.05f, 1.05f, 1.05f));
+  b.grid(V(x0, y1, h), V(x1 - x0, 0, 0), V(0, y0 - y1, 0), 2.6, 1.0f, 0.05f);
+  b.grade(0.35f, cv::Vec3f(0.95f, 1.05f, 1.12f));
+  b.grid(V(x0, y1, 0), V(x1 - x0, 0, 0), V(0, 0, h), 1.4, 1.0f, 0.1f);   // front
+  b.grid(V(x1, y0, 0), V(x0 - x1, 0, 0), V(0, 0, h), 1.4, 0.95f, 0.1f);  // back
+  b.grade(0.35f, cv::Vec3f(1.1f, 1.05f, 0.95f));
+  b.grid(V(x0, y0, 0), V(0, y1 - y0, 0), V(0, 0, h), 1.4, 0.9f, 0.1f);   // left
+  b.grid(V(x1, y1, 0), V(0, y0 - y1, 0), V(0, 0, h), 1.4, 0.9f, 0.1f);   // right
+  // Two desks in front: top slab, modesty panel and side panels (light wood-like grading).
+  b.grade(0.3f, cv::Vec3f(0.75f, 0.9f, 1.05f));
+  for (double cx : {-0.85, 0.85}) {
+    b.box(V(cx - 0.8, 3.0, 0.71), V(cx + 0.8, 3.8, 0.75), 1.0f);
+    b.box(V(cx - 0.78, 3.02, 0.25), V(cx + 0.78, 3.06, 0.71), 0.8f);
+    b.box(V(cx - 0.8, 3.0, 0), V(cx - 0.76, 3.8, 0.71), 0.8f);
+    b.box(V(cx + 0.76, 3.0, 0), V(cx + 0.8, 3.8, 0.71), 0.8f);
+  }
+  // Monitors, posters on the partition and the cabinets show their photographs as they are.
+  b.grade(1.0f, cv::Vec3f(1, 1, 1));
+  for (double cx : {-0.85, 0.85}) {
+    b.box(V(cx - 0.3, 3.5, 0.9), V(cx + 0.3, 3.55, 1.25), 0.9f);
+    b.box(V(cx - 0.04, 3.53, 0.75), V(cx + 0.04, 3.57, 0.9), 0.6f);
+  }
+  // Partition behind the desks, three panels.
+  for (int i = 0; i < 3; ++i) b.box(V(-2.1 + 1.4 * i, 3.95, 0), V(-0.7 + 1.4 * i, 4.0, 1.55), 0.95f);
+  // Cabinets and a shelf at the sides, a low cabinet and a side desk behind the start.
+  b.box(V(2.5, 1.2, 0), V(3.4, 2.4, 1.1), 0.9f);
+  b.box(V(-3.45, 0.4, 0), V(-2.95, 2.6, 1.9), 0.9f);
+  b.box(V(-1.0, -2.45, 0), V(1.0, -2.0, 1.0), 0.9f);
+  b.box(V(1.6, -2.45, 0.71), V(3.2, -1.65, 0.75), 1.0f);
+  b.box(V(-2.3, -1.6, 0), V(-2.25, 0.0, 1.4), 0.9f);
+  b.box(V(2.9, 3.0, 0), V(3.45, 4.8, 1.6), 0.9f);
+}
+
+Pose startPose() { return lookAt(Eigen::Vector3d(0, 0, 1.35), Eigen::Vector3d(0, 3.5, 0.8)); }
+
+}  // namespace
+
+// A person: a walker (ping-pong along a floor segment) or a sitter (slight sway).
+struct SequenceGenerator::Person {
+  int id = 0;
+  const SpriteTrack* track = nullptr;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // floor points (sitter: a only)
+  double speed = 1.0, phase = 0, height = 1.75, anim_phase = 0;
+  bool sitting = false, mirror = false;
+  int box_id = 0;        // > 0: carries a box with this id
+};
+
+const std::vector<PresetInfo>& presets() {
+  static const std::vector<PresetInfo> p = {
+      {"walking_xyz", "replay", "two people walking; the real fr3_walking_xyz camera motion", 827, 2, 0, false},
+      {"walking_static", "static", "two people walking; camera on a tripod", 743, 2, 0, false},
+      {"walking_rpy", "rpy", "two people walking; camera rotating about its axes", 910, 2, 0, false},
+      {"walking_half", "halfsphere", "two people walking, one carrying a box; camera on a half sphere", 1067, 2, 0, true},
+      {"sitting_static", "static", "two people sitting at the desks, moving slightly", 707, 0, 2, false},
+      {"static_xyz", "xyz", "no people; camera translating along its axes", 900, 0, 0, false},
+      {"loop", "loop", "one walker; the camera circles the room and returns to its start", 1200, 1, 0, false},
+  };
+  return p;
+}
+
+SynthOptions SynthOptions::load(const Config& cfg) {
+  SynthOptions o;
+  o.preset = cfg.getString("Synth.preset", o.preset);
+  int seed = cfg.getInt("Synth.seed", (int)o.seed);
+  if (seed < 0) throw Error(cfg.path() + ": Synth.seed must be >= 0");
+  o.seed = (unsigned)seed;
+  o.frames = cfg.getInt("Synth.frames", o.frames);
+  o.textures_dir = cfg.getString("Synth.textures", o.textures_dir);
+  o.trajectory = cfg.getString("Synth.trajectory", o.trajectory);
+  o.fps = cfg.getDouble("Synth.fps", o.fps);
+  o.threads = cfg.getInt("Synth.threads", o.threads);
+  if (o.frames < 0 || o.fps <= 0 || o.threads < 1)
+    throw Error(cfg.path() + ": Synth.frames must be >= 0, Synth.fps > 0, Synth.threads >= 1");
+  o.sensor = SensorOptions::load(cfg);
+  if (cfg.has("Camera.fx")) o.camera = CameraModel::load(cfg);
+  return o;
+}
+
+SequenceGenerator::~SequenceGenerator() = default;
+
+SequenceGenerator::SequenceGenerator(const SynthOptions& opt) : opt_(opt) {
+  auto it = std::find_if(presets().begin(), presets().end(),
+                         [&](const PresetInfo& p) { return p.name == opt.preset; });
+  if (it == presets().end()) {
+    std::string names;
+    for (const auto& p : presets()) names += (names.empty() ? "" : "|") + p.name;
+    throw Error("unknown preset '" + opt.preset + "': use one of " + names);
+  }
+  preset_ = *it;
+  if (opt_.frames < 0 || opt_.fps <= 0) throw Error("frames must be >= 0 and fps > 0");
+  if (opt_.threads < 1) opt_.threads = 1;
+
+  const std::string tex_dir = opt_.textures_dir.empty() ? defaultTextureDir() : opt_.textures_dir;
+  textures_ = loadTextures(tex_dir);
+  for (const auto& t : textures_) texture_files_.push_back(t.name);
+  buildRoom(textures_, room_);
+  renderer_ = std::make_unique<Renderer>(opt_.camera, textures_);
+
+  // Camera motion.
+  std::string traj = opt_.trajectory.empty() ? preset_.motion : opt_.trajectory;
+  if (traj == "replay") traj = realGroundTruth();
+  const auto& names = CameraPath::builtInNames();
+  if (std::find(names.begin(), names.end(), traj) != names.end())
+    path_ = std::make_unique<CameraPath>(CameraPath::builtIn(traj, startPose()));
+  else
+    path_ = std::make_unique<CameraPath>(CameraPath::replay(io::readTrajectory(traj), startPose(), traj));
+
+  // Frame stamps: 30 Hz with sub-millisecond jitter; depth a few ms after rgb, as in TUM.
+  int n = opt_.frames > 0 ? opt_.frames : preset_.frames;
+  cv::RNG rng(mix(opt_.seed, 0x57A3));
+  for (int i = 0; i < n; ++i) {
+    double s = round6(kBaseStamp + i / opt_.fps + rng.uniform(-0.0008, 0.0008));
+    rgb_stamps_.push_back(s);
+    depth_stamps_.push_back(round6(s + rng.uniform(0.0005, 0.006)));
+  }
+  t0_ = kBaseStamp;
+
+  // People.
+  cv::RNG prng(mix(opt_.seed, 0xBEEF));
+  int next_id = 1;
+  if (preset_.walkers > 0) {
+    walkers_ = cachedWalkers(opt_.walker_video.empty() ? defaultWalkerVideo() : opt_.walker_video);
+    // Floor segments 1 to 3.5 m from the start position, in front of the desks; the loop's
+    // walker uses the left side so the circling camera never walks into it.
+    std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segs;
+    if (preset_.name == "loop")
+      segs = {{Eigen::Vector3d(-2.4, -1.0, 0), Eigen::Vector3d(-1.9, 2.6, 0)}};
+    else
+      segs = {{Eigen::Vector3d(-2.2, 2.0, 0), Eigen::Vector3d(2.2, 2.7, 0)},
+              {Eigen::Vector3d(2.0, 2.8, 0), Eigen::Vector3d(-1.4, 1.6, 0)}};
+    size_t first = (size_t)prng.uniform(0, (int)walkers_->size());
+    for (int k = 0; k < preset_.walkers; ++k) {
+      Person p;
+      p.id = next_id++;
+      p.track = &(*walkers_)[(first + 3 * k) % walkers_->size()];
+      p.a = segs[k % segs.size()].first;
+      p.b = segs[k % segs.size()].second;
+      p.speed = prng.uniform(0.8, 1.2);
+      p.phase = prng.uniform(0.0, 1.0);
+      p.height = prng.uniform(1.65, 1.85);
+      p.anim_phase = prng.uniform(0.0, 10.0);
+      people_.push_back(p);
+    }
+    if (preset_.carried_box && !people_.empty()) people_.back().box_id = 100;
+  }
+  if (preset_.sitters > 0) {
+    sitters_ = cachedTumPeople(opt_.tum_people_dir.empty() ? defaultTumPeopleDir() : opt_.tum_people_dir);
+    const Eigen::Vector3d seats[2] = {Eigen::Vector3d(-0.75, 2.6, 0), Eigen::Vector3d(0.8, 2.5, 0)};
+    for (int k = 0; k < preset_.sitters; ++k) {
+      Person p;
+      p.id = next_id++;
+      p.track = &(*sitters_)[k % sitters_->size()];
+      p.a = seats[k % 2];
+      p.sitting = true;
+      p.mirror = k % 2 == 1;
+      p.height = p.track->height_m;
+      p.phase = prng.uniform(0.0, 2 * kPi);
+      people_.push_back(p);
+    }
+  }
+  for (size_t i = 0; i < texture_files_.size(); ++i)
+    if (texture_files_[i] == "box_in_scene.png" || texture_files_[i] == "board.jpg") box_texture_ = (int)i;
+}
+
+std::vector<Quad> SequenceGenerator::dynamicQuads(double t, const Pose& T_wc) const {
+  std::vector<Quad> out;
+  const Eigen::Vector3d cam = T_wc.translation();
+  for (const Person& p : people_) {
+    Eigen::Vector3d pos, vel = Eigen::Vector3d::Zero();
+    if (p.sitting) {
+      pos = p.a;
+    } else {
+      Eigen::Vector3d d = p.b - p.a;
+      double L = d.norm();
+      double s = std::fmod(p.phase * 2 * L + t * p.speed, 2 * L);
+      if (s < L) pos = p.a + d * (s / L), vel = d / L * p.speed;
+      else pos = p.b - d * ((s - L) / L), vel = -d / L * p.speed;
+    }
+    // Billboard facing the camera (horizontally), standing on the floor.
+    Eigen::Vector3d n = cam - pos;
+    n.z() = 0;
+    if (n.norm() < 1e-6) continue;
+    n.normalize();
+    Eigen::Vector3d right = kUp.cross(n);
+    if (p.sitting) pos += right * (0.03 * std::sin(2 * kPi * t / 5.0 + p.phase));
+    size_t k = p.track->fps > 0 ? (size_t)std::floor((t + p.anim_phase) * p.track->fps) % p.track->frames.size() : 0;
+    const Sprite& sp = p.track->frames[k];
+    double hs = p.height * p.track->height_scale[k];
+    if (p.sitting) hs *= 1.0 + 0.01 * std::sin(2 * kPi * t / 3.7 + p.phase);
+    double ws = hs * sp.bgra.cols / sp.bgra.rows;
+    Quad q;
+    q.origin = pos - right * (0.5 * ws);
+    q.edge_u = right * ws;
+    q.edge_v = kUp * hs;
+    q.sprite = &sp;
+    q.object_id = p.id;
+    // Sprites face +u: mirror when walking towards the left of the image.
+    bool mirror = p.sitting ? p.mirror : vel.dot(right) < 0;
+    q.tex_rect = mirror ? cv::Rect2f((float)sp.bgra.cols, 0, -(float)sp.bgra.cols, (float)sp.bgra.rows)
+                        : cv::Rect2f(0, 0, (float)sp.bgra.cols, (float)sp.bgra.rows);
+    out.push_back(q);
+    if (p.box_id > 0) {
+      // A box held at hip height in front of the body, on the side it walks towards.
+      Eigen::Vector3d dir = vel.norm() > 1e-6 ? Eigen::Vector3d(vel.normalized()) : right;
+      Eigen::Vector3d side = kUp.cross(dir);
+      Eigen::Vector3d c = pos + dir * 0.3 + kUp * 1.0;
+      Eigen::Vector3d ex = dir * 0.4, ey = side * 0.3, ez = kUp * 0.3;
+      Eigen::Vector3d lo = c - 0.5 * (ex + ey + ez);
+      auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev) {
+        Quad f;
+        f.origin = o;
+        f.edge_u = eu;
+        f.edge_v = ev;
+        f.texture = box_texture_;
+        const Texture& tx = textures_[box_texture_];
+        f.tex_rect = cv::Rect2f(0, 0, (float)tx.width() * 0.5f, (float)tx.height() * 0.5f);
+        f.brightness = 0.9f;
+        f.two_sided = false;
+        f.object_id = p.box_id;
+        out.push_back(f);
+      };
+      // Outward normals (edge_u x edge_v) for back-face culling.
+      face(lo, ex, ez);       // -ey
+      face(lo + ey, ez, ex);  // +ey
+      face(lo, ez, ey);       // -ex
+      face(lo + ex, ey, ez);  // +ex
+      face(lo + ez, ex, ey);  // +ez
+      face(lo, ey, ex);       // -ez
+    }
+  }
+  return out;
+}
+
+SynthFrame SequenceGenerator::frame(size_t i) const {
+  if (i >= size()) throw Error("frame index " + std::to_string(i) + " out of range");
+  SynthFrame f;
+  f.index = i;
+  f.rgb_stamp = rgb_stamps_[i];
+  f.depth_stamp = depth_stamps_[i];
+  const double t = f.rgb_stamp - t0_;
+  f.T_wc = path_->at(t);
+  std::vector<Quad> dyn = dynamicQuads(t, f.T_wc);
+  std::vector<Quad> all = room_;
+  all.insert(all.end(), dyn.begin(), dyn.end());
+  RenderOutput ro;
+  renderer_->render(f.T_wc, all, ro);
+  f.depth_exact = ro.depth;
+  f.ids = ro.ids;
+  f.mask = ro.ids > 0;
+
+  // Per-object truth from the id buffer.
+  std::vector<int> ids;
+  for (const Quad& q : dyn)
+    if (std::find(ids.begin(), ids.end(), q.object_id) == ids.end()) ids.push_back(q.object_id);
+  for (int id : ids) {
+    cv::Mat m = ro.ids == id;
+    int px = cv::countNonZero(m);
+    if (px < 20) continue;
+    ObjectTruth o;
+    o.id = id;
+    o.cls = id >= 100 ? "box" : "person";
+    o.box = cv::boundingRect(m);
+    o.pixels = px;
+    double full = renderer_->unoccludedArea(f.T_wc, dyn, id);
+    o.visible_fraction = full > 0 ? std::min(1.0, px / full) : 0.0;
+    f.objects.push_back(o);
+  }
+
+  cv::RNG rng(mix(opt_.seed, 1000 + i));
+  f.bgr = ro.bgr;
+  if (opt_.sensor.motion_blur && opt_.sensor.exposure > 0) {
+    // Image motion of the point 2 m ahead during the exposure.
+    Pose T_prev = path_->at(t - opt_.sensor.exposure / opt_.fps);
+    Eigen::Vector3d Xw = f.T_wc * Eigen::Vector3d(0, 0, 2.0);
+    Eigen::Vector3d pc = T_prev.inverse() * Xw;
+    Eigen::Vector2d uv = opt_.camera.project(pc);
+    cv::Point2f shift((float)(uv.x() - opt_.camera.cx), (float)(uv.y() - opt_.camera.cy));
+    applyMotionBlur(f.bgr, shift);
+  }
+  if (opt_.sensor.noise) applyImageNoise(f.bgr, opt_.sensor.image_noise, rng);
+  f.depth = applyDepthModel(ro.depth, opt_.sensor, rng);
+  return f;
+}
+
+double SequenceGenerator::generate(const std::string& out_dir, bool progress) const {
+  Stopwatch sw;
+  makeDir(out_dir);
+  for (const char* sub : {"rgb", "depth", "masks"}) makeDir(joinPath(out_dir, sub));
+  const size_t n = size();
+  std::vector<std::vector<ObjectTruth>> objects(n);
+  Trajectory gt(n);
+  std::atomic<size_t> next{0};
+  std::mutex err_mu;  // guards first_error
+  std::exception_ptr first_error;
+  std::atomic<size_t> done{0};
+  ProgressBar bar("synth " + preset_.name, n);
+  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  auto work = [&]() {
+    try {
+      for (size_t i; (i = next++) < n;) {
+        SynthFrame f = frame(i);
+        const std::string rs = stampStr(f.rgb_stamp), ds = stampStr(f.depth_stamp);
+        cv::Mat d16;
+        f.depth.convertTo(d16, CV_16U, opt_.camera.depth_map_factor);
+        const std::string rp = joinPath(out_dir, "rgb/" + rs + ".png");
+        const std::string dp = joinPath(out_dir, "depth/" + ds + ".png");
+        const std::string mp = joinPath(out_dir, "masks/" + rs + ".png");
+        if (!cv::imwrite(rp, f.bgr, png) || !cv::imwrite(dp, d16, png) || !cv::imwrite(mp, f.mask, png))
+          throw Error("cannot write frame " + rs + " into " + out_dir + ": check free space and permissions");
+        objects[i] = f.objects;
+        gt[i].stamp = f.rgb_stamp;
+        gt[i].T_wc = f.T_wc;
+        size_t d = ++done;
+        if (progress && opt_.threads >= 1) {
+          std::lock_guard<std::mutex> lock(err_mu);
+          bar.update(d);
+        }
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(err_mu);
+      if (!first_error) first_error = std::current_exception();
+      next = n;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < opt_.threads; ++k) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+  if (first_error) std::rethrow_exception(first_error);
+  if (progress) bar.finish();
+
+  auto open = [&](const std::string& name) {
+    auto f = std::make_unique<std::ofstream>(joinPath(out_dir, name));
+    if (!*f) throw Error("cannot write " + joinPath(out_dir, name) + ": check permissions");
+    return f;
+  };
+  const std::string src = "yolo_slam_synth --preset " + preset_.name + " --seed " + std::to_string(opt_.seed);
+  {
+    auto f = open("rgb.txt");
+    *f << "# color images\n# file: '" << src << "'\n# timestamp filename\n";
+    for (size_t i = 0; i < n; ++i) *f << stampStr(rgb_stamps_[i]) << " rgb/" << stampStr(rgb_stamps_[i]) << ".png\n";
+  }
+  {
+    auto f = open("depth.txt");
+    *f << "# depth maps\n# file: '" << src << "'\n# timestamp filename\n";
+    for (size_t i = 0; i < n; ++i) *f << stampStr(depth_stamps_[i]) << " depth/" << stampStr(depth_stamps_[i]) << ".png\n";
+  }
+  {
+    // ORB-SLAM2's association format (no header: its reader does not skip comments).
+    auto f = open("associations.txt");
+    for (size_t i = 0; i < n; ++i)
+      *f << stampStr(rgb_stamps_[i]) << " rgb/" << stampStr(rgb_stamps_[i]) << ".png " << stampStr(depth_stamps_[i])
+         << " depth/" << stampStr(depth_stamps_[i]) << ".png\n";
+  }
+  {
+    auto f = open("boxes.txt");
+    *f << "# dynamic objects per frame (" << src << ")\n"
+       << "# box = visible pixels; x2 y2 exclusive; visible_fraction = visible / unoccluded unclipped area\n"
+       << "# rgb_timestamp id class x1 y1 x2 y2 visible_fraction\n";
+    char buf[256];
+    for (size_t i = 0; i < n; ++i)
+      for (const auto& o : objects[i]) {
+        std::snprintf(buf, sizeof buf, "%s %d %s %d %d %d %d %.3f\n", stampStr(rgb_stamps_[i]).c_str(), o.id,
+                      o.cls.c_str(), o.box.x, o.box.y, o.box.x + o.box.width, o.box.y + o.box.height,
+                      o.visible_fraction);
+        *f << buf;
+      }
+  }
+  {
+    const CameraModel& c = opt_.camera;
+    auto f = open("camera.yaml");
+    char buf[2048];
+    std::snprintf(buf, sizeof buf,
+                  "%%YAML:1.0\n# Camera of a yolo_slam_synth sequence (%s): ORB-SLAM2 keys.\n"
+                  "Camera.fx: %.6f\nCamera.fy: %.6f\nCamera.cx: %.6f\nCamera.cy: %.6f\n"
+                  "Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n"
+                  "Camera.width: %d\nCamera.height: %d\nCamera.fps: %.1f\nCamera.bf: %.6f\nCamera.RGB: 1\n"
+                  "ThDepth: %.1f\nDepthMapFactor: %.1f\n"
+                  "ORBextractor.nFeatures: 1000\nORBextractor.scaleFactor: 1.2\nORBextractor.nLevels: 8\n"
+                  "ORBextractor.iniThFAST: 20\nORBextractor.minThFAST: 7\n",
+                  src.c_str(), c.fx, c.fy, c.cx, c.cy, c.width, c.height, opt_.fps, c.bf, c.th_depth,
+                  c.depth_map_factor);
+    *f << buf;
+  }
+  {
+    auto f = open("synth_info.txt");
+    *f << "# how this sequence was made\ncommand: " << src << " --frames " << n << "\n"
+       << "description: " << preset_.description << "\ntrajectory: " << path_->name() << "\ntextures:";
+    for (const auto& t : texture_files_) *f << " " << t;
+    *f << "\n";
+    for (const Person& p : people_) *f << "person " << p.id << ": " << p.track->source << "\n";
+  }
+  io::writeTrajectory(joinPath(out_dir, "groundtruth.txt"), gt);
+  return sw.ms() / 1000.0;
+}
+
+}  // namespace sim
+}  // namespace yolo_slam

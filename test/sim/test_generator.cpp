@@ -1,0 +1,251 @@
+// Checks of the synthetic sequence generator: geometry of the rendering, determinism, the TUM
+// layout, masks against boxes and the depth sensor model.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/paths.h"
+#include "yolo_slam/io/depth.h"
+#include "yolo_slam/io/tum_sequence.h"
+#include "yolo_slam/sim/generator.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+using namespace yolo_slam;
+
+namespace {
+
+// A fresh temporary folder, removed at the end of the test binary.
+std::string tempDir() {
+  static struct Cleanup {
+    std::vector<std::string> dirs;
+    ~Cleanup() {
+      for (const auto& d : dirs) std::filesystem::remove_all(d);
+    }
+  } cleanup;
+  char tmpl[] = "/tmp/sim_testXXXXXX";
+  const char* d = ::mkdtemp(tmpl);
+  EXPECT_NE(d, nullptr);
+  if (!d) return "/tmp/sim_test_failed";
+  cleanup.dirs.push_back(d);
+  return d;
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+sim::SynthOptions opts(const std::string& preset, int frames, unsigned seed = 1) {
+  sim::SynthOptions o;
+  o.preset = preset;
+  o.frames = frames;
+  o.seed = seed;
+  return o;
+}
+
+}  // namespace
+
+// Static pixels of two frames one second apart, back-projected with the ground-truth poses,
+// land on the same world points.
+TEST(SimGenerator, BackProjectionOfStaticPixelsAgreesAcrossOneSecond) {
+  for (const char* preset : {"walking_xyz", "walking_rpy"}) {
+    sim::SynthOptions o = opts(preset, 31);
+    o.sensor.noise = false;
+    sim::SequenceGenerator gen(o);
+    sim::SynthFrame a = gen.frame(0), b = gen.frame(30);
+    ASSERT_NEAR(b.rgb_stamp - a.rgb_stamp, 1.0, 0.01);
+    ASSERT_GT((a.T_wc.translation() - b.T_wc.translation()).norm() +
+                  rotationAngle(a.T_wc.linear().transpose() * b.T_wc.linear()),
+              0.02)
+        << preset << ": the camera should move within a second";
+    const CameraModel& cam = gen.camera();
+    const Pose T_bw = b.T_wc.inverse();
+    std::vector<double> err;
+    for (int v = 0; v < cam.height; v += 6)
+      for (int u = 0; u < cam.width; u += 6) {
+        float z = a.depth_exact.at<float>(v, u);
+        if (z <= 0 || a.ids.at<uint16_t>(v, u) != 0) continue;
+        Eigen::Vector3d Xw = a.T_wc * cam.unproject(u, v, z);
+        Eigen::Vector3d pb = T_bw * Xw;
+        if (pb.z() <= 0.1) continue;
+        Eigen::Vector2d uv = cam.project(pb);
+        int ub = (int)std::lround(uv.x()), vb = (int)std::lround(uv.y());
+        if (!cam.inImage(ub, vb)) continue;
+        float zb = b.depth_exact.at<float>(vb, ub);
+        if (zb <= 0 || b.ids.at<uint16_t>(vb, ub) != 0) continue;
+        // The re-rendered point at the rounded pixel: compare along the viewing ray.
+        Eigen::Vector3d Xb = b.T_wc * cam.unproject(uv.x(), uv.y(), zb);
+        err.push_back((Xb - Xw).norm());
+      }
+    ASSERT_GT(err.size(), 1000u) << preset;
+    std::nth_element(err.begin(), err.begin() + err.size() / 2, err.end());
+    EXPECT_LT(err[err.size() / 2], 0.01) << preset << ": median back-projection disagreement";
+    std::printf("%s: median back-projection disagreement %.2f mm over %zu pixels\n", preset,
+                1000 * err[err.size() / 2], err.size());
+  }
+}
+
+TEST(SimGenerator, SameSeedGivesIdenticalBytes) {
+  std::string d1 = tempDir(), d2 = tempDir(), d3 = tempDir();
+  sim::SequenceGenerator(opts("walking_static", 3, 7)).generate(d1);
+  sim::SynthOptions o = opts("walking_static", 3, 7);
+  o.threads = 1;  // thread count must not change the output
+  sim::SequenceGenerator(o).generate(d2);
+  sim::SequenceGenerator(opts("walking_static", 3, 8)).generate(d3);
+  io::TumSequence s1 = io::TumSequence::open(d1);
+  ASSERT_EQ(s1.size(), 3u);
+  for (const char* f : {"rgb.txt", "depth.txt", "groundtruth.txt", "associations.txt", "boxes.txt"})
+    EXPECT_EQ(readAll(d1 + "/" + f), readAll(d2 + "/" + f)) << f;
+  for (const auto& fr : s1.frames()) {
+    EXPECT_EQ(readAll(fr.rgb_path), readAll(d2 + fr.rgb_path.substr(d1.size()))) << fr.rgb_path;
+    EXPECT_EQ(readAll(fr.depth_path), readAll(d2 + fr.depth_path.substr(d1.size()))) << fr.depth_path;
+  }
+  EXPECT_NE(readAll(d1 + "/rgb.txt"), readAll(d3 + "/rgb.txt")) << "another seed, other stamps";
+}
+
+TEST(SimGenerator, WritesReadableTumLayout) {
+  std::string d = tempDir();
+  sim::SequenceGenerator gen(opts("walking_xyz", 5));
+  gen.generate(d);
+  for (const char* f : {"rgb.txt", "depth.txt"}) {
+    std::ifstream in(d + "/" + f);
+    std::string l1, l2, l3;
+    std::getline(in, l1), std::getline(in, l2), std::getline(in, l3);
+    EXPECT_EQ(l1[0], '#') << f;
+    EXPECT_EQ(l3, "# timestamp filename") << f;
+  }
+  io::TumSequence seq = io::TumSequence::open(d);
+  ASSERT_EQ(seq.size(), 5u);
+  ASSERT_TRUE(seq.hasGroundTruth());
+  EXPECT_EQ(seq.groundTruth().size(), 5u);
+  for (size_t i = 0; i < seq.size(); ++i) {
+    const auto& f = seq.frames()[i];
+    EXPECT_GT(f.depth_stamp, f.rgb_stamp);
+    EXPECT_LT(f.depth_stamp - f.rgb_stamp, 0.01);
+    if (i > 0) EXPECT_NEAR(f.rgb_stamp - seq.frames()[i - 1].rgb_stamp, 1 / 30.0, 0.002);
+    cv::Mat rgb = seq.loadRgb(i);
+    EXPECT_EQ(rgb.size(), cv::Size(640, 480));
+    cv::Mat raw = cv::imread(f.depth_path, cv::IMREAD_ANYDEPTH);
+    EXPECT_EQ(raw.type(), CV_16U);
+    cv::Mat mask = cv::imread(d + "/masks/" + f.rgb_path.substr(f.rgb_path.rfind('/') + 1), cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(mask.type(), CV_8U);
+    EXPECT_EQ(mask.size(), rgb.size());
+  }
+  // Ground truth equals the poses the frames were rendered with.
+  sim::SynthFrame f2 = gen.frame(2);
+  EXPECT_NEAR((seq.groundTruth()[2].T_wc.translation() - f2.T_wc.translation()).norm(), 0, 1e-6);
+  EXPECT_NEAR(seq.groundTruth()[2].stamp, f2.rgb_stamp, 1e-9);
+  // The rgb/depth lists associate like TUM's associate.py, pairing each frame with its depth.
+  sim::SynthOptions o;
+  CameraModel cam = CameraModel::load(Config::fromFile(d + "/camera.yaml"));
+  EXPECT_DOUBLE_EQ(cam.fx, 535.4);
+  EXPECT_DOUBLE_EQ(cam.cy, 247.6);
+  EXPECT_DOUBLE_EQ(cam.depth_map_factor, 5000.0);
+  std::remove((d + "/associations.txt").c_str());
+  io::TumSequence assoc = io::TumSequence::open(d);
+  ASSERT_EQ(assoc.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) EXPECT_EQ(assoc.frames()[i].depth_stamp, seq.frames()[i].depth_stamp);
+}
+
+TEST(SimGenerator, BoxesEncloseMaskPixelsOfTheirObject) {
+  std::string d = tempDir();
+  sim::SequenceGenerator gen(opts("walking_half", 4));
+  gen.generate(d);
+  std::ifstream in(d + "/boxes.txt");
+  std::string line;
+  std::map<std::string, std::vector<std::vector<double>>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    std::string stamp, cls;
+    double id, x1, y1, x2, y2, vis;
+    ASSERT_TRUE(bool(ss >> stamp >> id >> cls >> x1 >> y1 >> x2 >> y2 >> vis)) << line;
+    EXPECT_TRUE(cls == "person" || cls == "box") << line;
+    EXPECT_GT(vis, 0.0);
+    EXPECT_LE(vis, 1.0);
+    rows[stamp].push_back({id, x1, y1, x2, y2});
+  }
+  int people = 0;
+  for (size_t i = 0; i < gen.size(); ++i) {
+    sim::SynthFrame f = gen.frame(i);
+    char stamp[32];
+    std::snprintf(stamp, sizeof stamp, "%.6f", f.rgb_stamp);
+    cv::Mat mask = cv::imread(d + "/masks/" + stamp + ".png", cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(cv::countNonZero(mask != f.mask), 0);
+    EXPECT_EQ(cv::countNonZero((f.ids > 0) != (mask == 255)), 0);
+    for (const auto& r : rows[stamp]) {
+      cv::Mat m = f.ids == (int)r[0];
+      cv::Rect b((int)r[1], (int)r[2], (int)(r[3] - r[1]), (int)(r[4] - r[2]));
+      EXPECT_EQ(cv::countNonZero(m), cv::countNonZero(m(b))) << "id " << r[0] << " escapes its box";
+      EXPECT_EQ(cv::boundingRect(m), b);
+      ++people;
+    }
+  }
+  EXPECT_GT(people, 0) << "walking_half should show someone in its first frames";
+}
+
+TEST(SimGenerator, DepthModelLikeAKinect) {
+  sim::SequenceGenerator gen(opts("static_xyz", 1));
+  sim::SynthFrame f = gen.frame(0);
+  double maxd;
+  cv::minMaxLoc(f.depth, nullptr, &maxd);
+  EXPECT_LE(maxd, 4.5);
+  // The room reaches beyond 4.5 m from the start view, so some exact depths are lost.
+  EXPECT_GT(cv::countNonZero(f.depth_exact > 4.5), 0);
+  int holes = cv::countNonZero((f.depth == 0) & (f.depth_exact > 0.6) & (f.depth_exact < 4.0));
+  EXPECT_GT(holes, 50) << "edges and random holes should lose readings";
+  EXPECT_LT(holes, 0.2 * 640 * 480);
+
+  // Noise grows with the square of depth: planes at 1 m and 3 m.
+  sim::SensorOptions so;
+  so.hole_rate = 0;
+  cv::RNG rng(3);
+  std::vector<double> sd;
+  for (float z : {1.0f, 3.0f}) {
+    cv::Mat exact(120, 160, CV_32F, z);
+    cv::Mat d = sim::applyDepthModel(exact, so, rng);
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(d(cv::Rect(2, 2, 156, 116)) - z, mean, stddev);
+    EXPECT_NEAR(mean[0], 0.0, 0.01 * z * z);
+    sd.push_back(stddev[0]);
+  }
+  EXPECT_GT(sd[1], 4 * sd[0]);
+  EXPECT_LT(sd[0], 0.01);
+  // Quantised disparity: few distinct values on a far plane.
+  cv::Mat far = sim::applyDepthModel(cv::Mat(60, 60, CV_32F, 4.0f), so, rng);
+  std::set<float> values(far.begin<float>(), far.end<float>());
+  EXPECT_LT(values.size(), 40u);
+}
+
+TEST(SimGenerator, ErrorsNameTheCause) {
+  sim::SynthOptions o = opts("walking_nowhere", 2);
+  try {
+    sim::SequenceGenerator g(o);
+    FAIL() << "unknown preset accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("walking_nowhere"), std::string::npos);
+  }
+  o = opts("static_xyz", 2);
+  o.textures_dir = "/nonexistent/textures";
+  EXPECT_THROW(sim::SequenceGenerator{o}, Error);
+  o = opts("static_xyz", 2);
+  o.trajectory = "/nonexistent/groundtruth.txt";
+  try {
+    sim::SequenceGenerator g(o);
+    FAIL() << "missing trajectory accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/groundtruth.txt"), std::string::npos);
+  }
+}
