@@ -1,0 +1,64 @@
+#pragma once
+// A keyframe: a frozen Frame with its pose, map-point associations, covisibility graph edges,
+// spanning-tree links, loop edges and BoW slot. Owned by the Map (see map.h: every mutable
+// member is accessed only with Map::update_mutex held; `id` and `frame_id` are const).
+#include "yolo_slam/slam/frame.h"
+#include "yolo_slam/slam/types.h"
+
+#include <map>
+#include <set>
+#include <vector>
+
+namespace yolo_slam {
+namespace slam {
+
+class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
+ public:
+  KeyFrame(long id, const Frame& frame);
+
+  const long id;
+  const long frame_id;
+  Frame f;                      // keypoints, grid, pose (f.T_cw), map points (f.points), BoW
+
+  // Covisibility graph: keyframes sharing >= 15 points (or the best one), weight = shared points.
+  std::map<KeyFramePtr, int, ById> connections;
+  std::vector<KeyFramePtr> ordered_connections;   // by decreasing weight
+  std::vector<int> ordered_weights;
+  // Spanning tree. A child does not own its parent's lifetime link in reverse: children are raw
+  // pointers, valid because an erased keyframe removes itself from its parent's children.
+  KeyFramePtr parent;
+  std::set<KeyFrame*> children;
+  bool first_connection = true;
+  std::set<KeyFramePtr, ById> loop_edges;          // for loop closing (later issue)
+  bool bad = false;
+  bool not_erase = false;                          // protected from culling (loop closing)
+  bool is_origin = false;                          // first keyframe of the map: never erased
+  Pose T_cp = Pose::Identity();                    // pose relative to parent, kept when erased
+  long ba_local_for = -1, ba_fixed_for = -1;       // local BA scratch
+
+  const Pose& Tcw() const { return f.T_cw; }
+  Pose Twc() const { return f.T_cw.inverse(); }
+  Eigen::Vector3d center() const { return f.T_cw.inverse().translation(); }
+
+  void addMapPoint(const MapPointPtr& mp, size_t idx) { f.points[idx] = mp; }
+  void eraseMapPointMatch(size_t idx) { f.points[idx].reset(); }
+  std::vector<MapPointPtr> mapPoints() const;      // live, non-null
+  int trackedMapPoints(int min_obs) const;         // points with >= min_obs observations
+
+  // Rebuilds this keyframe's covisibility edges from its points (both directions) and, on the
+  // first call, attaches it to the spanning tree under the best-covisible keyframe.
+  void updateConnections();
+  void addConnection(const KeyFramePtr& kf, int weight);
+  void eraseConnection(const KeyFramePtr& kf);
+  void updateBestCovisibles();
+  std::vector<KeyFramePtr> bestCovisibles(size_t n) const;
+  std::vector<KeyFramePtr> covisiblesByWeight(int w) const;
+  int weight(const KeyFramePtr& kf) const;
+  // Median depth of the points seen (for baselines in triangulation).
+  double sceneMedianDepth() const;
+
+  KeyFramePtr self() { return shared_from_this(); }
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,99 @@
+#pragma once
+// Local mapping (own thread, owned by System): processes the keyframes that Tracking inserts
+// through a bounded queue: associates their points, culls recent points, triangulates new
+// points with the best covisible keyframes, fuses duplicates, runs local bundle adjustment
+// (Ceres, aborted when a new keyframe arrives) and culls redundant keyframes.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/slam/options.h"
+#include "yolo_slam/slam/types.h"
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <list>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace yolo_slam {
+namespace vocabulary {
+class Vocabulary;
+}
+namespace slam {
+
+class LocalMapping {
+ public:
+  LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
+               std::shared_ptr<const vocabulary::Vocabulary> vocabulary);
+  ~LocalMapping();
+  LocalMapping(const LocalMapping&) = delete;
+  LocalMapping& operator=(const LocalMapping&) = delete;
+
+  void start();          // spawns the thread (idempotent)
+  void stop();           // finishes the keyframe in progress, joins; queued ones are dropped
+
+  // Called by Tracking (holding map.update_mutex). Returns false if the queue is full.
+  bool insertKeyFrame(const KeyFramePtr& kf);
+  bool acceptsKeyFrames() const { return accept_.load(); }
+  size_t queued() const;
+  int queueCapacity() const { return opt_.queue_size; }
+  void interruptBA() { abort_ba_.store(true); }
+
+  // Pausing (localization-only mode, reset): the thread finishes its current keyframe and
+  // waits. waitUntilPaused() blocks until it does. The caller must NOT hold map.update_mutex.
+  void pause();
+  void waitUntilPaused();
+  void resume();
+  bool paused() const { return pause_requested_.load(); }
+  // Blocks until the queue is empty and the thread is idle (tests, deterministic runs).
+  // The caller must NOT hold map.update_mutex.
+  void waitIdle();
+  // Drops queued keyframes and the recent-points list (while paused, for reset).
+  void clear();
+
+  // Milliseconds per processed keyframe (copy; thread-safe).
+  std::vector<double> timings() const;
+  size_t processedKeyFrames() const;
+  size_t culledKeyFrames() const;
+
+  // One keyframe's whole processing, synchronous (the thread calls this; tests may too when
+  // the thread is not started).
+  void processOne(const KeyFramePtr& kf);
+
+ private:
+  void run();
+  void processNewKeyFrame();
+  void mapPointCulling();
+  void createNewMapPoints();
+  void searchInNeighbors();
+  void localBundleAdjustment();
+  void keyFrameCulling();
+
+  Map& map_;
+  CameraModel cam_;
+  LocalMappingOptions opt_;
+  std::shared_ptr<const vocabulary::Vocabulary> voc_;
+
+  // Guards queue_, busy_, paused_ack_, stop_, timings_, counters. Taken alone or after
+  // map.update_mutex (Tracking inserts while holding it), never before it.
+  mutable std::mutex queue_mutex_;
+  std::condition_variable cv_;
+  std::deque<KeyFramePtr> queue_;
+  bool busy_ = false;
+  bool paused_ack_ = false;
+  bool stop_ = false;
+  std::vector<double> timings_;
+  size_t processed_ = 0, culled_ = 0;
+
+  std::atomic<bool> accept_{true};
+  std::atomic<bool> abort_ba_{false};
+  std::atomic<bool> pause_requested_{false};
+  std::thread thread_;
+
+  // Mapping-thread state (only touched by the thread running processOne).
+  KeyFramePtr current_;
+  std::list<MapPointPtr> recent_points_;
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,84 @@
+#pragma once
+// The map: the single owner of KeyFrames and MapPoints.
+//
+// OWNERSHIP. Keyframes and points are created by Tracking/LocalMapping and handed to the Map
+// (addKeyFrame/addMapPoint); only the Map erases them (eraseKeyFrame/eraseMapPoint/replace).
+// Objects are held by std::shared_ptr: the Map's sets, the keyframe <-> point association
+// (KeyFrame::f.points, MapPoint::observations), covisibility edges and the spanning-tree parent
+// link. Erasing flags the object `bad`, removes it from the Map and breaks every link to and from
+// it, so it is freed as soon as the last outside holder (e.g. Tracking's last frame, a
+// trajectory record that still refers to an erased reference keyframe) lets go. Holders must
+// check `bad` and follow MapPoint::replaced. clear() breaks all cycles before dropping the sets.
+// Nobody keeps a raw pointer beyond the scope of a locked section, except the ones documented in
+// keyframe.h / map_point.h (children, ref_kf) which the erase logic keeps valid.
+//
+// LOCKING. One coarse mutex, `update_mutex`, guards the whole map graph: the Map's sets and every
+// mutable member of every KeyFrame and MapPoint (poses, positions, associations, covisibility,
+// tree, flags, counters). Tracking holds it for the whole processing of a frame; LocalMapping
+// holds it for each step of a keyframe, but releases it while Ceres solves the local bundle
+// adjustment on a copy (BaProblem) and re-takes it to write the result back; System takes it for
+// snapshots/trajectories. There are no per-object mutexes, so there is no lock-order problem
+// inside the map; the only other mutexes (LocalMapping queue, System stats) are always taken
+// AFTER update_mutex or alone, never the other way round.
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/map_point.h"
+#include "yolo_slam/slam/types.h"
+
+#include <atomic>
+#include <mutex>
+#include <set>
+#include <vector>
+
+namespace yolo_slam {
+namespace slam {
+
+class Map {
+ public:
+  Map() = default;
+  ~Map() { clear(); }
+  Map(const Map&) = delete;
+  Map& operator=(const Map&) = delete;
+
+  // Guards everything described above. Lock order: update_mutex first.
+  mutable std::mutex update_mutex;
+
+  // Ids are unique over the map's lifetime (not reused after clear()); atomic so they can be
+  // drawn without the mutex.
+  long newKeyFrameId() { return next_kf_id_++; }
+  long newPointId() { return next_point_id_++; }
+
+  // --- all below: caller holds update_mutex ---
+  void addKeyFrame(const KeyFramePtr& kf);
+  void addMapPoint(const MapPointPtr& mp);
+  // Adds the observation both ways (kf->f.points[idx] = mp and mp->observations[kf] = idx).
+  static void addObservation(const MapPointPtr& mp, const KeyFramePtr& kf, size_t idx);
+  // Removes one observation both ways; a point left with <= 2 observations is erased
+  // (ORB-SLAM2 EraseObservation).
+  void eraseObservation(const MapPointPtr& mp, const KeyFramePtr& kf);
+  void eraseMapPoint(const MapPointPtr& mp);
+  // Erases a keyframe: observations, covisibility edges, spanning-tree re-parenting of its
+  // children (ORB-SLAM2 SetBadFlag). The first keyframe is never erased.
+  void eraseKeyFrame(const KeyFramePtr& kf);
+  // `mp` is fused into `by`: its observations move to `by` (ORB-SLAM2 MapPoint::Replace).
+  void replaceMapPoint(const MapPointPtr& mp, const MapPointPtr& by);
+
+  std::vector<KeyFramePtr> keyframes() const;   // sorted by id
+  std::vector<MapPointPtr> mapPoints() const;   // sorted by id
+  size_t numKeyFrames() const { return keyframes_.size(); }
+  size_t numMapPoints() const { return points_.size(); }
+  KeyFramePtr origin() const { return origin_; }
+  long maxKeyFrameId() const { return keyframes_.empty() ? -1 : (*keyframes_.rbegin())->id; }
+
+  // Drops everything, breaking the reference cycles first.
+  void clear();
+
+ private:
+  std::set<KeyFramePtr, ById> keyframes_;
+  std::set<MapPointPtr, ById> points_;
+  KeyFramePtr origin_;
+  std::atomic<long> next_kf_id_{0};
+  std::atomic<long> next_point_id_{0};
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

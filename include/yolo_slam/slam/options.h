@@ -1,0 +1,48 @@
+#pragma once
+// Options of the SLAM core (tracking and local mapping), read from the Tracking.* and
+// LocalMapping.* keys. Defaults are ORB-SLAM2's constants for RGB-D.
+#include <string>
+
+namespace yolo_slam {
+
+class Config;
+
+namespace slam {
+
+struct TrackingOptions {
+  int init_min_keypoints = 500;     // Tracking.initMinKeyPoints: keypoints with depth to initialise
+  int motion_window = 15;           // Tracking.motionWindow: projection radius (px, level 0) of the motion model
+  int local_window = 3;             // Tracking.localWindow: radius factor for the local-map search (RGB-D: 3)
+  int min_inliers = 30;             // Tracking.minInliers: below this after local-map tracking the frame fails
+  int max_frames_between_kf = 0;    // Tracking.maxFrames: 0 = camera fps (ORB-SLAM2)
+  int min_frames_between_kf = 0;    // Tracking.minFrames
+  double ref_ratio = 0.75;          // Tracking.refRatio: keyframe if tracked < ratio * reference's points
+  int close_tracked_max = 100;      // Tracking.closeTrackedMax: close-point criterion (tracked < this
+  int close_untracked_min = 70;     // Tracking.closeUntrackedMin:  and untracked > this)
+  int lost_reset_frames = 150;      // Tracking.lostResetFrames: lost for this many frames ...
+  int lost_reset_max_keyframes = 5; // Tracking.lostResetMaxKeyFrames: ... with a map this small: reset
+  int vo_points = 100;              // Tracking.voPoints: temporary close points in the last frame
+  double max_stamp_gap = 1.0;       // Tracking.maxStampGap (s): a larger gap drops the motion model
+
+  static TrackingOptions load(const Config& cfg);
+};
+
+struct LocalMappingOptions {
+  int triangulation_neighbours = 10;  // LocalMapping.triangulationNeighbours (ORB-SLAM2: 10 stereo/RGB-D)
+  int fuse_neighbours = 10;           // LocalMapping.fuseNeighbours
+  double culling_redundancy = 0.9;    // LocalMapping.cullingRedundancy: keyframe culled if this share
+                                      // of its points is seen by >= 3 other keyframes
+  bool local_ba = true;               // LocalMapping.localBA
+  int queue_size = 3;                 // LocalMapping.queueSize: bounded keyframe queue
+
+  static LocalMappingOptions load(const Config& cfg);
+};
+
+struct SlamOptions {
+  TrackingOptions tracking;
+  LocalMappingOptions mapping;
+  static SlamOptions load(const Config& cfg);
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,122 @@
+#pragma once
+// The SLAM system: wires extraction, screening, tracking (caller's thread) and local mapping
+// (own thread). The one object driven by the offline runner and the ROS nodelets.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/geometry.h"
+#include "yolo_slam/detection/box.h"
+#include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/screening/screener.h"
+#include "yolo_slam/slam/options.h"
+#include "yolo_slam/slam/track_result.h"
+
+#include <opencv2/core.hpp>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace yolo_slam {
+
+class Config;
+
+namespace vocabulary {
+class Vocabulary;
+}
+
+namespace slam {
+
+class Map;
+class Tracking;
+class LocalMapping;
+
+struct MapSnapshot {
+  std::vector<Eigen::Vector3d> points;                 // static map points only, world frame
+  Trajectory keyframes;                                // T_wc, sorted by keyframe id
+  std::vector<std::pair<int, int>> covisibility_edges; // indices into keyframes (weight >= 15)
+};
+
+// Counters and timing samples (milliseconds) for stats.json.
+struct SystemStats {
+  size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0, resets = 0;
+  size_t keyframes_culled = 0;
+  long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
+  std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
+};
+
+// Everything System reads from the settings file, in one place (tools override fields, e.g. the
+// runner's --dynamic-mode, before constructing the System).
+struct SystemOptions {
+  features::OrbOptions orb;              // ORBextractor.*
+  screening::ScreeningOptions screening; // Screening.*
+  SlamOptions slam;                      // Tracking.*, LocalMapping.*
+  static SystemOptions load(const Config& cfg);
+};
+
+class System {
+ public:
+  // Reads the ORBextractor.*, Screening.*, Tracking.* and LocalMapping.* keys of `cfg` (throws
+  // yolo_slam::Error naming the file and key on bad values) and starts the mapping thread.
+  System(const CameraModel& cam, const Config& cfg,
+         std::shared_ptr<const vocabulary::Vocabulary> vocabulary /* may be null: no BoW */);
+  System(const CameraModel& cam, const SystemOptions& options,
+         std::shared_ptr<const vocabulary::Vocabulary> vocabulary);
+  ~System();  // calls shutdown()
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  // Extract + screen + track. `image`: BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F
+  // metres (0/NaN invalid) or empty. Bad input (empty image, wrong depth size/type) is reported
+  // on stderr and the frame is reported lost; never throws for per-frame data problems.
+  TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                        const detection::Boxes& boxes);
+  // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
+  TrackResult trackFeatures(const features::FeatureFrame& frame);
+
+  void reset();
+  void setLocalizationOnly(bool on);
+  bool localizationOnly() const;
+  void shutdown();  // stops and joins the mapping thread; idempotent
+
+  Trajectory cameraTrajectory() const;    // every tracked frame, T_wc
+  Trajectory keyframeTrajectory() const;  // keyframes (also those of maps dropped by a reset)
+  MapSnapshot mapSnapshot() const;
+  std::string statsJson() const;
+  SystemStats stats() const;
+
+  // Extra API for tools and tests.
+  // Blocks until local mapping has processed every queued keyframe.
+  void waitForLocalMapping();
+  // Timing of the detector, measured by the caller that runs it (reported in the stats).
+  void recordDetectionTime(double ms);
+  const features::OrbExtractor& extractor() const;
+  const screening::Screener& screener() const;
+  TrackingState state() const;
+
+ private:
+  void resetInternal(bool keep_trajectory);
+
+  CameraModel cam_;
+  SlamOptions opt_;
+  std::unique_ptr<features::OrbExtractor> orb_;
+  std::unique_ptr<screening::Screener> screener_;
+  std::shared_ptr<const vocabulary::Vocabulary> voc_;
+  std::unique_ptr<Map> map_;
+  std::unique_ptr<LocalMapping> mapper_;
+  std::unique_ptr<Tracking> tracker_;
+
+  // Serialises the tracking entry points (trackRgbd/trackFeatures/reset/setLocalizationOnly)
+  // against each other. Lock order: track_mutex_, then map->update_mutex, then stats_mutex_.
+  mutable std::mutex track_mutex_;
+  // Guards stats_ (taken last, alone or after the mutexes above).
+  mutable std::mutex stats_mutex_;
+  SystemStats stats_;
+  bool shut_down_ = false;
+  std::atomic<bool> localization_only_{false};
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,118 @@
+#pragma once
+// Tracking (runs on the caller's thread): ORB-SLAM2's RGB-D front end. Initialisation from
+// the first frame with enough depth, constant-velocity motion model, reference-keyframe
+// fallback, local-map tracking, pose-only optimisation and the keyframe decision.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/slam/frame.h"
+#include "yolo_slam/slam/options.h"
+#include "yolo_slam/slam/track_result.h"
+#include "yolo_slam/slam/types.h"
+
+#include <memory>
+#include <vector>
+
+namespace yolo_slam {
+namespace vocabulary {
+class Vocabulary;
+}
+namespace slam {
+
+class LocalMapping;
+
+// One output pose: relative to a reference keyframe, so that the trajectory follows the
+// keyframe corrections of local BA (ORB-SLAM2 mlRelativeFramePoses). `ref` null: T_wc absolute.
+struct FrameRecord {
+  double stamp = 0;
+  KeyFramePtr ref;
+  Pose T_cr = Pose::Identity();
+  Pose T_wc = Pose::Identity();
+};
+
+class Tracking {
+ public:
+  Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map, LocalMapping* mapper,
+           std::shared_ptr<const vocabulary::Vocabulary> vocabulary,
+           std::shared_ptr<const ScalePyramid> pyramid);
+
+  // Tracks one frame. The caller holds map.update_mutex.
+  TrackResult track(const features::FeatureFrame& ff);
+
+  // True after track() when the map should be reset (lost for long with a small map).
+  bool resetRequested() const { return reset_requested_; }
+  // Forgets the map state (the map itself is cleared by System). Keeps the trajectory,
+  // converted to absolute poses; the next map starts at the last tracked pose.
+  void resetKeepTrajectory();
+  // Full reset: trajectory too, next map starts at identity.
+  void resetAll();
+
+  void setLocalizationOnly(bool on) { localization_only_ = on; }
+  bool localizationOnly() const { return localization_only_; }
+  TrackingState state() const { return state_; }
+
+  // Caller holds map.update_mutex.
+  Trajectory trajectory() const;
+  size_t frames() const { return frames_; }
+  size_t trackedFrames() const { return tracked_; }
+  size_t lostFrames() const { return lost_; }
+  size_t resets() const { return resets_; }
+  const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
+  // Called by System before the map is cleared: remembers the keyframe poses of the old map.
+  void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
+
+ private:
+  bool initialize(Frame& F);
+  bool trackMotionModel(Frame& F);
+  bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
+  bool trackWhenLost(Frame& F);
+  bool trackLocalMap(Frame& F);
+  void updateLastFrame();
+  void updateLocalMap(Frame& F);
+  void searchLocalPoints(Frame& F);
+  int optimizePose(Frame& F);
+  bool needNewKeyFrame(const Frame& F) const;
+  void createNewKeyFrame(Frame& F);
+  void computeBow(Frame& F) const;
+  void record(const Frame& F);
+
+  CameraModel cam_;
+  TrackingOptions opt_;
+  Map& map_;
+  LocalMapping* mapper_;
+  std::shared_ptr<const vocabulary::Vocabulary> voc_;
+  std::shared_ptr<const ScalePyramid> pyr_;
+  FrameGeometry geom_;
+  int max_frames_ = 30, min_frames_ = 0;
+
+  TrackingState state_ = TrackingState::NotInitialized;
+  bool localization_only_ = false;
+  long next_frame_id_ = 0;
+  Frame last_;
+  bool has_last_ = false;
+  KeyFramePtr ref_kf_;          // reference keyframe of the current frame
+  KeyFramePtr last_kf_;
+  long last_kf_frame_id_ = -1;
+  Pose T_lr_ = Pose::Identity();   // last frame relative to its reference keyframe
+  KeyFramePtr last_ref_;
+  bool has_velocity_ = false;
+  Pose velocity_ = Pose::Identity();  // T_cl: current from last
+  int inliers_ = 0;
+  int failures_in_row_ = 0;
+  int lost_frames_in_row_ = 0;
+  double last_stamp_ = 0;
+  bool has_last_stamp_ = false;
+  Pose last_good_T_wc_ = Pose::Identity();
+  bool has_last_good_ = false;
+  bool reset_requested_ = false;
+  std::vector<KeyFramePtr> local_kfs_;
+  std::vector<MapPointPtr> local_points_;
+  std::vector<MapPointPtr> dynamic_hits_;
+  std::vector<MapPointPtr> temporary_points_;
+
+  std::vector<FrameRecord> records_;
+  Trajectory frozen_keyframes_;
+  size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0;
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

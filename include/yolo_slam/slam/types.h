@@ -1,0 +1,35 @@
+#pragma once
+// Forward declarations and pointer types of the SLAM map objects.
+#include "yolo_slam/vocabulary/bow_vector.h"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+namespace yolo_slam {
+namespace slam {
+
+class KeyFrame;
+class MapPoint;
+class Map;
+using KeyFramePtr = std::shared_ptr<KeyFrame>;
+using MapPointPtr = std::shared_ptr<MapPoint>;
+
+// Bag-of-words slot (filled when a vocabulary is loaded; used by relocalisation/loop closing
+// later and by reference-keyframe tracking): word -> weight, node -> feature indices.
+struct BowData {
+  vocabulary::BowVector bow;
+  vocabulary::FeatureVector features;
+  bool empty() const { return bow.empty(); }
+};
+
+// Orders shared pointers by object id so that iteration order (and so every result) is
+// deterministic, not dependent on heap addresses.
+struct ById {
+  template <class P>
+  bool operator()(const P& a, const P& b) const { return a->id < b->id; }
+};
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,443 @@
+#include "yolo_slam/slam/local_mapping.h"
+
+#include "yolo_slam/common/timing.h"
+#include "yolo_slam/optimization/bundle_adjustment.h"
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/map.h"
+#include "yolo_slam/slam/map_point.h"
+#include "yolo_slam/slam/matcher.h"
+#include "yolo_slam/vocabulary/vocabulary.h"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <unordered_map>
+
+namespace yolo_slam {
+namespace slam {
+
+LocalMapping::LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
+                           std::shared_ptr<const vocabulary::Vocabulary> vocabulary)
+    : map_(map), cam_(cam), opt_(opt), voc_(std::move(vocabulary)) {
+  if (opt_.queue_size < 1) opt_.queue_size = 1;
+}
+
+LocalMapping::~LocalMapping() { stop(); }
+
+void LocalMapping::start() {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  if (thread_.joinable()) return;
+  stop_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void LocalMapping::stop() {
+  {
+    std::lock_guard<std::mutex> lk(queue_mutex_);
+    stop_ = true;
+    abort_ba_.store(true);
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+bool LocalMapping::insertKeyFrame(const KeyFramePtr& kf) {
+  {
+    std::lock_guard<std::mutex> lk(queue_mutex_);
+    if (static_cast<int>(queue_.size()) >= opt_.queue_size) return false;
+    queue_.push_back(kf);
+    abort_ba_.store(true);
+    accept_.store(false);
+  }
+  cv_.notify_all();
+  return true;
+}
+
+size_t LocalMapping::queued() const {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  return queue_.size();
+}
+
+void LocalMapping::pause() {
+  pause_requested_.store(true);
+  abort_ba_.store(true);
+  cv_.notify_all();
+}
+
+void LocalMapping::waitUntilPaused() {
+  std::unique_lock<std::mutex> lk(queue_mutex_);
+  if (!thread_.joinable()) return;
+  cv_.wait(lk, [this] { return paused_ack_ || stop_ || !pause_requested_.load(); });
+}
+
+void LocalMapping::resume() {
+  {
+    std::lock_guard<std::mutex> lk(queue_mutex_);
+    pause_requested_.store(false);
+  }
+  cv_.notify_all();
+}
+
+void LocalMapping::waitIdle() {
+  std::unique_lock<std::mutex> lk(queue_mutex_);
+  if (!thread_.joinable()) return;
+  cv_.wait(lk, [this] { return stop_ || paused_ack_ || (queue_.empty() && !busy_); });
+}
+
+void LocalMapping::clear() {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  queue_.clear();
+  recent_points_.clear();
+  current_.reset();
+  accept_.store(true);
+}
+
+std::vector<double> LocalMapping::timings() const {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  return timings_;
+}
+size_t LocalMapping::processedKeyFrames() const {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  return processed_;
+}
+size_t LocalMapping::culledKeyFrames() const {
+  std::lock_guard<std::mutex> lk(queue_mutex_);
+  return culled_;
+}
+
+void LocalMapping::run() {
+  std::unique_lock<std::mutex> lk(queue_mutex_);
+  while (true) {
+    cv_.wait(lk, [this] { return stop_ || pause_requested_.load() || !queue_.empty(); });
+    if (stop_) break;
+    if (pause_requested_.load()) {
+      paused_ack_ = true;
+      accept_.store(false);
+      cv_.notify_all();
+      cv_.wait(lk, [this] { return stop_ || !pause_requested_.load(); });
+      paused_ack_ = false;
+      accept_.store(queue_.empty());
+      continue;
+    }
+    KeyFramePtr kf = queue_.front();
+    queue_.pop_front();
+    busy_ = true;
+    accept_.store(false);
+    lk.unlock();
+    Stopwatch sw;
+    processOne(kf);
+    const double ms = sw.ms();
+    lk.lock();
+    busy_ = false;
+    timings_.push_back(ms);
+    ++processed_;
+    if (queue_.empty()) accept_.store(true);
+    cv_.notify_all();
+  }
+  busy_ = false;
+  cv_.notify_all();
+}
+
+namespace {
+bool queueEmpty(std::mutex& m, const std::deque<KeyFramePtr>& q) {
+  std::lock_guard<std::mutex> lk(m);
+  return q.empty();
+}
+}  // namespace
+
+void LocalMapping::processOne(const KeyFramePtr& kf) {
+  current_ = kf;
+  {
+    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    processNewKeyFrame();
+    mapPointCulling();
+    createNewMapPoints();
+  }
+  if (queueEmpty(queue_mutex_, queue_)) {
+    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    searchInNeighbors();
+  }
+  abort_ba_.store(false);
+  if (queueEmpty(queue_mutex_, queue_) && !pause_requested_.load()) {
+    if (opt_.local_ba) localBundleAdjustment();
+    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    keyFrameCulling();
+  }
+  current_.reset();
+}
+
+void LocalMapping::processNewKeyFrame() {
+  KeyFrame& kf = *current_;
+  if (voc_ && kf.f.bow.empty() && kf.f.N > 0)
+    voc_->transform(kf.f.descriptors, kf.f.bow.bow, kf.f.bow.features, 4);
+  for (size_t i = 0; i < kf.f.points.size(); ++i) {
+    MapPointPtr mp = kf.f.points[i];
+    if (!mp) continue;
+    if (mp->bad || kf.f.dynamic[i]) {
+      kf.f.points[i].reset();
+      continue;
+    }
+    auto it = mp->observations.find(current_);
+    if (it == mp->observations.end()) {
+      Map::addObservation(mp, current_, i);
+      mp->updateNormalAndDepth();
+      mp->computeDistinctiveDescriptor();
+    } else if (it->second != i) {
+      kf.f.points[i].reset();  // the same point on two keypoints: keep the first association
+    } else {
+      recent_points_.push_back(mp);  // created by Tracking for this keyframe
+    }
+  }
+  kf.updateConnections();
+  map_.addKeyFrame(current_);
+}
+
+void LocalMapping::mapPointCulling() {
+  const long cur = current_->id;
+  for (auto it = recent_points_.begin(); it != recent_points_.end();) {
+    const MapPointPtr& mp = *it;
+    int nobs = 0;
+    for (const auto& o : mp->observations) nobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
+    if (mp->bad) {
+      it = recent_points_.erase(it);
+    } else if (mp->foundRatio() < 0.25) {
+      map_.eraseMapPoint(mp);
+      it = recent_points_.erase(it);
+    } else if (cur - mp->first_kf_id >= 2 && nobs <= 3) {
+      map_.eraseMapPoint(mp);
+      it = recent_points_.erase(it);
+    } else if (cur - mp->first_kf_id >= 3) {
+      it = recent_points_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+namespace {
+
+bool triangulate(const Eigen::Vector3d& xn1, const Eigen::Vector3d& xn2, const Pose& T1,
+                 const Pose& T2, Eigen::Vector3d& X) {
+  Eigen::Matrix<double, 3, 4> P1 = T1.matrix().topRows<3>(), P2 = T2.matrix().topRows<3>();
+  Eigen::Matrix4d A;
+  A.row(0) = xn1.x() * P1.row(2) - P1.row(0);
+  A.row(1) = xn1.y() * P1.row(2) - P1.row(1);
+  A.row(2) = xn2.x() * P2.row(2) - P2.row(0);
+  A.row(3) = xn2.y() * P2.row(2) - P2.row(1);
+  Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
+  Eigen::Vector4d h = svd.matrixV().col(3);
+  if (std::fabs(h(3)) < 1e-12) return false;
+  X = h.head<3>() / h(3);
+  return X.allFinite();
+}
+
+}  // namespace
+
+void LocalMapping::createNewMapPoints() {
+  const KeyFramePtr& kf1 = current_;
+  const auto& pyr = *kf1->f.pyramid;
+  const double ratio_factor = 1.5 * pyr.scale_factor;
+  std::vector<KeyFramePtr> neigh = kf1->bestCovisibles(opt_.triangulation_neighbours);
+  const Pose T1 = kf1->Tcw();
+  const Eigen::Vector3d O1 = kf1->center();
+  const Eigen::Matrix3d K = (Eigen::Matrix3d() << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1).finished();
+  const Eigen::Matrix3d Kinv = K.inverse();
+  for (const KeyFramePtr& kf2 : neigh) {
+    if (kf2->bad) continue;
+    if (!queueEmpty(queue_mutex_, queue_) && kf2 != neigh.front()) break;
+    const Eigen::Vector3d O2 = kf2->center();
+    if ((O2 - O1).norm() < cam_.baseline()) continue;
+    const Pose T2 = kf2->Tcw();
+    const Pose T21 = T2 * T1.inverse();
+    const Eigen::Matrix3d F21 = Kinv.transpose() * skew(T21.translation()) * T21.linear() * Kinv;
+    auto matches = matcher::searchForTriangulation(*kf1, *kf2, F21);
+    const Eigen::Matrix3d R1wc = T1.linear().transpose(), R2wc = T2.linear().transpose();
+    for (const auto& m : matches) {
+      const size_t i1 = m.first, i2 = m.second;
+      const cv::KeyPoint& k1 = kf1->f.kps[i1];
+      const cv::KeyPoint& k2 = kf2->f.kps[i2];
+      const double ur1 = kf1->f.right_u[i1], ur2 = kf2->f.right_u[i2];
+      const bool stereo1 = ur1 >= 0, stereo2 = ur2 >= 0;
+      const Eigen::Vector3d xn1 = Kinv * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
+      const Eigen::Vector3d xn2 = Kinv * Eigen::Vector3d(k2.pt.x, k2.pt.y, 1.0);
+      const Eigen::Vector3d ray1 = R1wc * xn1, ray2 = R2wc * xn2;
+      const double cos_rays = ray1.dot(ray2) / (ray1.norm() * ray2.norm());
+      const double b = cam_.baseline();
+      const double cos_st1 = stereo1 ? std::cos(2 * std::atan2(b / 2, kf1->f.depth[i1])) : 2.0;
+      const double cos_st2 = stereo2 ? std::cos(2 * std::atan2(b / 2, kf2->f.depth[i2])) : 2.0;
+      const double cos_st = std::min(cos_st1, cos_st2);
+      Eigen::Vector3d X;
+      if (cos_rays < cos_st && cos_rays > 0 && (stereo1 || stereo2 || cos_rays < 0.9998)) {
+        if (!triangulate(xn1, xn2, T1, T2, X)) continue;
+      } else if (stereo1 && cos_st1 < cos_st2) {
+        if (!kf1->f.unprojectWorld(i1, X)) continue;
+      } else if (stereo2 && cos_st2 < cos_st1) {
+        if (!kf2->f.unprojectWorld(i2, X)) continue;
+      } else {
+        continue;
+      }
+      const Eigen::Vector3d p1 = T1 * X, p2 = T2 * X;
+      if (p1.z() <= 0 || p2.z() <= 0) continue;
+      auto reproj_ok = [&](const Eigen::Vector3d& pc, const cv::KeyPoint& kp, double ur, bool stereo) {
+        const Eigen::Vector2d uv = cam_.project(pc);
+        const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
+        const double s2 = pyr.sigma2[kp.octave];
+        if (!stereo) return ex * ex + ey * ey <= 5.991 * s2;
+        const double er = uv.x() - cam_.bf / pc.z() - ur;
+        return ex * ex + ey * ey + er * er <= 7.8 * s2;
+      };
+      if (!reproj_ok(p1, k1, ur1, stereo1) || !reproj_ok(p2, k2, ur2, stereo2)) continue;
+      const double d1 = (X - O1).norm(), d2 = (X - O2).norm();
+      if (d1 == 0 || d2 == 0) continue;
+      const double ratio_dist = d2 / d1;
+      const double ratio_oct = pyr.scale[k1.octave] / pyr.scale[k2.octave];
+      if (ratio_dist * ratio_factor < ratio_oct || ratio_dist > ratio_oct * ratio_factor) continue;
+      auto mp = std::make_shared<MapPoint>(map_.newPointId(), X, kf1.get(), kf1->frame_id);
+      Map::addObservation(mp, kf1, i1);
+      Map::addObservation(mp, kf2, i2);
+      mp->computeDistinctiveDescriptor();
+      mp->updateNormalAndDepth();
+      map_.addMapPoint(mp);
+      recent_points_.push_back(mp);
+    }
+  }
+}
+
+void LocalMapping::searchInNeighbors() {
+  const KeyFramePtr& cur = current_;
+  if (cur->bad) return;
+  std::vector<KeyFramePtr> targets;
+  std::set<long> seen{cur->id};
+  for (const auto& kf : cur->bestCovisibles(opt_.fuse_neighbours)) {
+    if (kf->bad || !seen.insert(kf->id).second) continue;
+    targets.push_back(kf);
+  }
+  const size_t n1 = targets.size();
+  for (size_t k = 0; k < n1; ++k)
+    for (const auto& kf2 : targets[k]->bestCovisibles(5))
+      if (!kf2->bad && seen.insert(kf2->id).second) targets.push_back(kf2);
+
+  std::vector<MapPointPtr> cur_points = cur->mapPoints();
+  for (const auto& kf : targets) matcher::fuse(map_, kf, cur_points);
+
+  std::vector<MapPointPtr> candidates;
+  std::set<long> cand_ids;
+  for (const auto& kf : targets)
+    for (const auto& mp : kf->mapPoints())
+      if (!mp->dynamic && cand_ids.insert(mp->id).second) candidates.push_back(mp);
+  matcher::fuse(map_, cur, candidates);
+
+  for (const auto& mp : cur->mapPoints()) {
+    mp->computeDistinctiveDescriptor();
+    mp->updateNormalAndDepth();
+  }
+  cur->updateConnections();
+}
+
+void LocalMapping::localBundleAdjustment() {
+  optimization::BaProblem problem;
+  std::vector<KeyFramePtr> kfs;         // index = problem.keyframes index
+  std::vector<MapPointPtr> points;      // index = problem.points index
+  std::vector<std::pair<size_t, size_t>> obs_ref;  // (kf index, point index) per observation
+  {
+    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    if (current_->bad || map_.numKeyFrames() <= 2) return;
+    std::unordered_map<long, size_t> kf_index;
+    auto add_kf = [&](const KeyFramePtr& kf, bool fixed) {
+      kf_index[kf->id] = kfs.size();
+      kfs.push_back(kf);
+      problem.keyframes.push_back({kf->id, kf->Tcw(), fixed || kf->is_origin});
+    };
+    add_kf(current_, false);
+    for (const auto& kf : current_->ordered_connections)
+      if (!kf->bad && !kf_index.count(kf->id)) add_kf(kf, false);
+    const size_t n_local = kfs.size();
+    std::set<long> point_ids;
+    for (size_t k = 0; k < n_local; ++k) {
+      for (const auto& mp : kfs[k]->f.points) {
+        if (!mp || mp->bad || mp->dynamic || !point_ids.insert(mp->id).second) continue;
+        points.push_back(mp);
+      }
+    }
+    for (const auto& mp : points)
+      for (const auto& o : mp->observations)
+        if (!o.first->bad && !kf_index.count(o.first->id)) add_kf(o.first, true);
+    for (size_t p = 0; p < points.size(); ++p) {
+      const auto& mp = points[p];
+      problem.points.push_back({mp->id, mp->Xw});
+      for (const auto& o : mp->observations) {
+        if (o.first->bad) continue;
+        const Frame& f = o.first->f;
+        const cv::KeyPoint& kp = f.kps[o.second];
+        optimization::BaObservation ob;
+        ob.kf_id = o.first->id;
+        ob.point_id = mp->id;
+        ob.uv = Eigen::Vector2d(kp.pt.x, kp.pt.y);
+        ob.u_right = f.right_u[o.second] >= 0 ? f.right_u[o.second] : -1.0;
+        ob.inv_sigma2 = f.pyramid->inv_sigma2[kp.octave];
+        problem.observations.push_back(ob);
+        obs_ref.emplace_back(kf_index[o.first->id], p);
+      }
+    }
+  }
+  if (problem.observations.empty() || abort_ba_.load()) return;
+  optimization::BaResult result = optimization::localBundleAdjustment(cam_, problem, abort_ba_);
+
+  std::lock_guard<std::mutex> lk(map_.update_mutex);
+  for (size_t k = 0; k < obs_ref.size() && k < result.outlier_observation.size(); ++k) {
+    if (!result.outlier_observation[k]) continue;
+    const KeyFramePtr& kf = kfs[obs_ref[k].first];
+    const MapPointPtr& mp = points[obs_ref[k].second];
+    if (mp->bad || kf->bad) continue;
+    map_.eraseObservation(mp, kf);
+  }
+  for (size_t k = 0; k < kfs.size(); ++k) {
+    const auto& bk = problem.keyframes[k];
+    if (bk.fixed || kfs[k]->bad || !bk.T_cw.matrix().allFinite()) continue;
+    kfs[k]->f.T_cw = bk.T_cw;
+  }
+  for (size_t p = 0; p < points.size(); ++p) {
+    const auto& mp = points[p];
+    if (mp->bad || !problem.points[p].Xw.allFinite()) continue;
+    mp->Xw = problem.points[p].Xw;
+    mp->updateNormalAndDepth();
+  }
+}
+
+void LocalMapping::keyFrameCulling() {
+  if (current_->bad) return;
+  const double close = cam_.closeDepth();
+  const int th_obs = 3;
+  std::vector<KeyFramePtr> local = current_->ordered_connections;
+  for (const auto& kf : local) {
+    if (kf->bad || kf->is_origin || kf->not_erase) continue;
+    int n_points = 0, redundant = 0;
+    for (size_t i = 0; i < kf->f.points.size(); ++i) {
+      const MapPointPtr& mp = kf->f.points[i];
+      if (!mp || mp->bad) continue;
+      // RGB-D: only close points count (far ones are not reliable to judge redundancy).
+      if (kf->f.depth[i] > close || kf->f.depth[i] < 0) continue;
+      ++n_points;
+      int wobs = 0;
+      for (const auto& o : mp->observations) wobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
+      if (wobs <= th_obs) continue;
+      const int level = kf->f.kps[i].octave;
+      int n = 0;
+      for (const auto& o : mp->observations) {
+        if (o.first == kf) continue;
+        if (o.first->f.kps[o.second].octave <= level + 1 && ++n >= th_obs) break;
+      }
+      if (n >= th_obs) ++redundant;
+    }
+    if (n_points > 0 && redundant > opt_.culling_redundancy * n_points) {
+      map_.eraseKeyFrame(kf);
+      std::lock_guard<std::mutex> lk(queue_mutex_);
+      ++culled_;
+    }
+  }
+}
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,153 @@
+#include "yolo_slam/slam/map.h"
+
+#include <limits>
+
+namespace yolo_slam {
+namespace slam {
+
+void Map::addKeyFrame(const KeyFramePtr& kf) {
+  if (keyframes_.empty() && !origin_) {
+    origin_ = kf;
+    kf->is_origin = true;
+  }
+  keyframes_.insert(kf);
+}
+
+void Map::addMapPoint(const MapPointPtr& mp) { points_.insert(mp); }
+
+void Map::addObservation(const MapPointPtr& mp, const KeyFramePtr& kf, size_t idx) {
+  mp->observations[kf] = idx;
+  kf->f.points[idx] = mp;
+  if (!mp->ref_kf) mp->ref_kf = kf.get();
+}
+
+void Map::eraseObservation(const MapPointPtr& mp, const KeyFramePtr& kf) {
+  auto it = mp->observations.find(kf);
+  if (it == mp->observations.end()) return;
+  if (it->second < kf->f.points.size() && kf->f.points[it->second] == mp)
+    kf->f.points[it->second].reset();
+  mp->observations.erase(it);
+  if (mp->ref_kf == kf.get())
+    mp->ref_kf = mp->observations.empty() ? nullptr : mp->observations.begin()->first.get();
+  // ORB-SLAM2: observations with depth count twice; a point seen (stereo) once only is dropped.
+  int nobs = 0;
+  for (const auto& o : mp->observations) nobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
+  if (nobs <= 2) eraseMapPoint(mp);
+}
+
+void Map::eraseMapPoint(const MapPointPtr& mp) {
+  if (!mp) return;
+  mp->bad = true;
+  for (const auto& o : mp->observations) {
+    auto& slot = o.first->f.points[o.second];
+    if (slot == mp) slot.reset();
+  }
+  mp->observations.clear();
+  mp->ref_kf = nullptr;
+  points_.erase(mp);
+}
+
+void Map::replaceMapPoint(const MapPointPtr& mp, const MapPointPtr& by) {
+  if (!mp || !by || mp == by || mp->bad || by->bad) return;
+  auto obs = std::move(mp->observations);
+  mp->observations.clear();
+  mp->bad = true;
+  mp->replaced = by;
+  mp->ref_kf = nullptr;
+  for (const auto& o : obs) {
+    const KeyFramePtr& kf = o.first;
+    if (!by->inKeyFrame(kf.get())) {
+      kf->f.points[o.second] = by;
+      by->observations[kf] = o.second;
+      if (!by->ref_kf) by->ref_kf = kf.get();
+    } else if (kf->f.points[o.second] == mp) {
+      kf->f.points[o.second].reset();
+    }
+  }
+  by->found += mp->found;
+  by->visible += mp->visible;
+  by->dynamic = by->dynamic || mp->dynamic;
+  by->computeDistinctiveDescriptor();
+  points_.erase(mp);
+}
+
+void Map::eraseKeyFrame(const KeyFramePtr& kf) {
+  if (!kf || kf->bad || kf->is_origin || kf->not_erase) return;
+  for (const auto& c : kf->connections) c.first->eraseConnection(kf);
+  for (size_t i = 0; i < kf->f.points.size(); ++i) {
+    MapPointPtr mp = kf->f.points[i];
+    if (mp) eraseObservation(mp, kf);
+  }
+  kf->connections.clear();
+  kf->ordered_connections.clear();
+  kf->ordered_weights.clear();
+
+  // Re-attach the children (ORB-SLAM2 SetBadFlag): repeatedly pick the child with the strongest
+  // covisibility to an already-attached candidate (initially the erased keyframe's parent).
+  std::set<KeyFrame*> candidates;
+  if (kf->parent) candidates.insert(kf->parent.get());
+  while (!kf->children.empty()) {
+    int best_w = -1;
+    KeyFrame* best_child = nullptr;
+    KeyFramePtr best_parent;
+    for (KeyFrame* child : kf->children) {
+      if (child->bad) continue;
+      for (size_t j = 0; j < child->ordered_connections.size(); ++j) {
+        const KeyFramePtr& cand = child->ordered_connections[j];
+        if (candidates.count(cand.get()) && child->ordered_weights[j] > best_w) {
+          best_w = child->ordered_weights[j];
+          best_child = child;
+          best_parent = cand;
+        }
+      }
+    }
+    if (!best_child) break;
+    best_child->parent = best_parent;
+    best_parent->children.insert(best_child);
+    candidates.insert(best_child);
+    kf->children.erase(best_child);
+  }
+  // Children without covisibility to the candidates go to the erased keyframe's parent.
+  for (KeyFrame* child : kf->children) {
+    child->parent = kf->parent;
+    if (kf->parent) kf->parent->children.insert(child);
+  }
+  kf->children.clear();
+  if (kf->parent) {
+    kf->parent->children.erase(kf.get());
+    kf->T_cp = kf->Tcw() * kf->parent->Twc();
+  }
+  kf->loop_edges.clear();
+  kf->bad = true;
+  keyframes_.erase(kf);
+}
+
+std::vector<KeyFramePtr> Map::keyframes() const {
+  return std::vector<KeyFramePtr>(keyframes_.begin(), keyframes_.end());
+}
+
+std::vector<MapPointPtr> Map::mapPoints() const {
+  return std::vector<MapPointPtr>(points_.begin(), points_.end());
+}
+
+void Map::clear() {
+  for (const auto& kf : keyframes_) {
+    kf->f.points.clear();
+    kf->connections.clear();
+    kf->ordered_connections.clear();
+    kf->parent.reset();
+    kf->children.clear();
+    kf->loop_edges.clear();
+  }
+  for (const auto& mp : points_) {
+    mp->observations.clear();
+    mp->replaced.reset();
+    mp->ref_kf = nullptr;
+  }
+  keyframes_.clear();
+  points_.clear();
+  origin_.reset();
+}
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,330 @@
+#include "yolo_slam/slam/matcher.h"
+
+#include "yolo_slam/features/hamming.h"
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/map.h"
+#include "yolo_slam/slam/map_point.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace yolo_slam {
+namespace slam {
+namespace matcher {
+
+namespace {
+
+inline int dist(const cv::Mat& d, int row, const cv::Mat& d2, int row2) {
+  return features::hammingDistance(d.ptr<uint8_t>(row), d2.ptr<uint8_t>(row2));
+}
+inline int dist(const cv::Mat& mp_desc, const cv::Mat& d, int row) {
+  return features::hammingDistance(mp_desc.ptr<uint8_t>(), d.ptr<uint8_t>(row));
+}
+
+}  // namespace
+
+int rotationBin(float a1, float a2) {
+  float rot = a1 - a2;
+  if (rot < 0.0f) rot += 360.0f;
+  int bin = static_cast<int>(std::round(rot * (1.0f / 360.0f) * kHistLength));
+  if (bin >= kHistLength || bin < 0) bin = 0;
+  return bin;
+}
+
+std::vector<size_t> rotationOutliers(const std::vector<std::vector<size_t>>& hist) {
+  // Three largest bins; the 2nd/3rd are kept only if they hold >= 10% of the largest.
+  int m1 = 0, m2 = 0, m3 = 0, i1 = -1, i2 = -1, i3 = -1;
+  for (int i = 0; i < static_cast<int>(hist.size()); ++i) {
+    int s = static_cast<int>(hist[i].size());
+    if (s > m1) {
+      m3 = m2; i3 = i2; m2 = m1; i2 = i1; m1 = s; i1 = i;
+    } else if (s > m2) {
+      m3 = m2; i3 = i2; m2 = s; i2 = i;
+    } else if (s > m3) {
+      m3 = s; i3 = i;
+    }
+  }
+  if (m2 < 0.1 * m1) i2 = i3 = -1;
+  else if (m3 < 0.1 * m1) i3 = -1;
+  std::vector<size_t> out;
+  for (int i = 0; i < static_cast<int>(hist.size()); ++i) {
+    if (i == i1 || i == i2 || i == i3) continue;
+    out.insert(out.end(), hist[i].begin(), hist[i].end());
+  }
+  return out;
+}
+
+bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, Projection& out) {
+  if (!mp || mp->bad) return false;
+  const Eigen::Vector3d pc = F.T_cw * mp->Xw;
+  if (!(pc.z() > 0)) return false;
+  const Eigen::Vector2d uv = F.cam.project(pc);
+  if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
+    return false;
+  const Eigen::Vector3d PO = mp->Xw - F.cameraCenter();
+  const double d = PO.norm();
+  if (d < 0.8 * mp->min_dist || d > 1.2 * mp->max_dist) return false;
+  const double view_cos = PO.dot(mp->normal) / d;
+  if (view_cos < min_view_cos) return false;
+  out.mp = mp;
+  out.u = uv.x();
+  out.v = uv.y();
+  out.ur = uv.x() - F.cam.bf / pc.z();
+  out.level = mp->predictScale(d, F.pyramid->n_levels, F.pyramid->log_scale_factor);
+  out.view_cos = view_cos;
+  return true;
+}
+
+int searchLastFrame(Frame& F, const Frame& last, double th) {
+  int n = 0;
+  std::vector<std::vector<size_t>> hist(kHistLength);
+  std::vector<size_t> matched_idx;
+  const Pose T_lc = last.T_cw * F.T_cw.inverse();
+  const double tz = T_lc.inverse().translation().z();  // ORB-SLAM2 tlc(2)
+  const double b = F.cam.baseline();
+  const bool forward = tz > b, backward = -tz > b;
+  const auto& pyr = *F.pyramid;
+  for (int i = 0; i < last.N; ++i) {
+    const MapPointPtr& mp = last.points[i];
+    if (!mp || mp->bad || last.outlier[i] || mp->dynamic) continue;
+    const Eigen::Vector3d pc = F.T_cw * mp->Xw;
+    if (!(pc.z() > 0)) continue;
+    const Eigen::Vector2d uv = F.cam.project(pc);
+    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
+      continue;
+    const int oct = last.kps[i].octave;
+    const double radius = th * pyr.scale[oct];
+    std::vector<size_t> cand;
+    if (forward) cand = F.featuresInArea(uv.x(), uv.y(), radius, oct);
+    else if (backward) cand = F.featuresInArea(uv.x(), uv.y(), radius, 0, oct);
+    else cand = F.featuresInArea(uv.x(), uv.y(), radius, oct - 1, oct + 1);
+    if (cand.empty() || mp->descriptor.empty()) continue;
+    const double ur = uv.x() - F.cam.bf / pc.z();
+    int best = 256;
+    int best_idx = -1;
+    for (size_t j : cand) {
+      const MapPointPtr& cur = F.points[j];
+      if (cur && cur->numObservations() > 0) continue;
+      if (F.right_u[j] > 0 && std::fabs(ur - F.right_u[j]) > radius) continue;
+      int d = dist(mp->descriptor, F.descriptors, static_cast<int>(j));
+      if (d < best) {
+        best = d;
+        best_idx = static_cast<int>(j);
+      }
+    }
+    if (best <= kThHigh && best_idx >= 0) {
+      F.points[best_idx] = mp;
+      ++n;
+      hist[rotationBin(last.kps[i].angle, F.kps[best_idx].angle)].push_back(best_idx);
+    }
+  }
+  for (size_t idx : rotationOutliers(hist)) {
+    F.points[idx].reset();
+    --n;
+  }
+  return n;
+}
+
+int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, double nn_ratio,
+                      std::vector<MapPointPtr>* dynamic_hits) {
+  int n = 0;
+  const auto& pyr = *F.pyramid;
+  for (const Projection& p : proj) {
+    const MapPointPtr& mp = p.mp;
+    if (!mp || mp->bad || mp->descriptor.empty()) continue;
+    const double r = (p.view_cos > 0.998 ? 2.5 : 4.0) * th * pyr.scale[p.level];
+    std::vector<size_t> cand = F.featuresInArea(p.u, p.v, r, p.level - 1, p.level);
+    int best = 256, best2 = 256, best_level = -1, best_level2 = -1, best_idx = -1;
+    for (size_t j : cand) {
+      const MapPointPtr& cur = F.points[j];
+      if (cur && cur->numObservations() > 0) continue;
+      if (F.right_u[j] > 0 && std::fabs(p.ur - F.right_u[j]) > r) continue;
+      int d = dist(mp->descriptor, F.descriptors, static_cast<int>(j));
+      if (d < best) {
+        best2 = best;
+        best_level2 = best_level;
+        best = d;
+        best_level = F.kps[j].octave;
+        best_idx = static_cast<int>(j);
+      } else if (d < best2) {
+        best_level2 = F.kps[j].octave;
+        best2 = d;
+      }
+    }
+    if (dynamic_hits) {
+      // A point that now projects onto a dynamic keypoint with a better descriptor match than
+      // any static one sits on a moving object.
+      int best_dyn = 256;
+      for (size_t j : F.featuresInArea(p.u, p.v, r, p.level - 1, p.level, true))
+        best_dyn = std::min(best_dyn, dist(mp->descriptor, F.descriptors, static_cast<int>(j)));
+      if (best_dyn <= kThLow && best_dyn < best) {
+        dynamic_hits->push_back(mp);
+        continue;
+      }
+    }
+    if (best <= kThHigh && best_idx >= 0) {
+      if (best_level == best_level2 && best > nn_ratio * best2) continue;
+      F.points[best_idx] = mp;
+      ++n;
+    }
+  }
+  return n;
+}
+
+int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
+  int n = 0;
+  std::vector<std::vector<size_t>> hist(kHistLength);
+  std::vector<bool> taken(F.N, false);
+  auto it1 = kf.f.bow.features.begin(), end1 = kf.f.bow.features.end();
+  auto it2 = F.bow.features.begin(), end2 = F.bow.features.end();
+  while (it1 != end1 && it2 != end2) {
+    if (it1->first == it2->first) {
+      for (unsigned i1 : it1->second) {
+        if (i1 >= kf.f.points.size()) continue;
+        const MapPointPtr& mp = kf.f.points[i1];
+        if (!mp || mp->bad || mp->dynamic) continue;
+        int best = 256, best2 = 256, best_idx = -1;
+        for (unsigned i2 : it2->second) {
+          if (i2 >= static_cast<unsigned>(F.N) || taken[i2] || F.dynamic[i2]) continue;
+          int d = dist(kf.f.descriptors, static_cast<int>(i1), F.descriptors, static_cast<int>(i2));
+          if (d < best) {
+            best2 = best;
+            best = d;
+            best_idx = static_cast<int>(i2);
+          } else if (d < best2) {
+            best2 = d;
+          }
+        }
+        if (best_idx >= 0 && best <= kThLow && best < nn_ratio * best2) {
+          F.points[best_idx] = mp;
+          taken[best_idx] = true;
+          hist[rotationBin(kf.f.kps[i1].angle, F.kps[best_idx].angle)].push_back(best_idx);
+          ++n;
+        }
+      }
+      ++it1;
+      ++it2;
+    } else if (it1->first < it2->first) {
+      it1 = kf.f.bow.features.lower_bound(it2->first);
+    } else {
+      it2 = F.bow.features.lower_bound(it1->first);
+    }
+  }
+  for (size_t idx : rotationOutliers(hist)) {
+    F.points[idx].reset();
+    --n;
+  }
+  return n;
+}
+
+std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf1,
+                                                              const KeyFrame& kf2,
+                                                              const Eigen::Matrix3d& F12) {
+  // Epipole of camera 1 in image 2: candidates too close to it are ambiguous.
+  const Eigen::Vector3d C1_in_2 = kf2.Tcw() * kf1.center();
+  const auto& pyr = *kf1.f.pyramid;
+  Eigen::Vector2d ep(-1e9, -1e9);
+  if (C1_in_2.z() > 1e-9) ep = kf2.f.cam.project(C1_in_2);
+
+  std::vector<int> free2;
+  for (int j = 0; j < kf2.f.N; ++j)
+    if (!kf2.f.points[j] && !kf2.f.dynamic[j]) free2.push_back(j);
+  std::vector<int> match12(kf1.f.N, -1);
+  std::vector<int> best_for2(kf2.f.N, 256);
+  std::vector<int> owner2(kf2.f.N, -1);
+  for (int i = 0; i < kf1.f.N; ++i) {
+    if (kf1.f.points[i] || kf1.f.dynamic[i]) continue;
+    const cv::KeyPoint& k1 = kf1.f.kps[i];
+    const bool stereo1 = kf1.f.right_u[i] >= 0;
+    // Epipolar line in image 2: l = F12^T? With x2^T F12 x1 = 0 the line is F12 * x1.
+    const Eigen::Vector3d l = F12 * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
+    const double ln = l.head<2>().squaredNorm();
+    if (ln < 1e-18) continue;
+    int best = kThLow + 1, best_idx = -1;
+    for (int j : free2) {
+      const cv::KeyPoint& k2 = kf2.f.kps[j];
+      const bool stereo2 = kf2.f.right_u[j] >= 0;
+      const double num = l.x() * k2.pt.x + l.y() * k2.pt.y + l.z();
+      const double d2 = num * num / ln;
+      if (d2 >= 3.84 * pyr.sigma2[k2.octave]) continue;
+      const int d = dist(kf1.f.descriptors, i, kf2.f.descriptors, j);
+      if (d >= best) continue;
+      if (!stereo1 && !stereo2) {
+        const double ex = ep.x() - k2.pt.x, ey = ep.y() - k2.pt.y;
+        if (ex * ex + ey * ey < 100 * pyr.scale[k2.octave]) continue;
+      }
+      best = d;
+      best_idx = j;
+    }
+    if (best_idx >= 0 && best < best_for2[best_idx]) {
+      if (owner2[best_idx] >= 0) match12[owner2[best_idx]] = -1;
+      owner2[best_idx] = i;
+      best_for2[best_idx] = best;
+      match12[i] = best_idx;
+    }
+  }
+  std::vector<std::vector<size_t>> hist(kHistLength);
+  for (int i = 0; i < kf1.f.N; ++i)
+    if (match12[i] >= 0) hist[rotationBin(kf1.f.kps[i].angle, kf2.f.kps[match12[i]].angle)].push_back(i);
+  for (size_t i : rotationOutliers(hist)) match12[i] = -1;
+  std::vector<std::pair<size_t, size_t>> out;
+  for (int i = 0; i < kf1.f.N; ++i)
+    if (match12[i] >= 0) out.emplace_back(i, match12[i]);
+  return out;
+}
+
+int fuse(Map& map, const KeyFramePtr& kf, const std::vector<MapPointPtr>& points, double th) {
+  int n = 0;
+  const Frame& F = kf->f;
+  const auto& pyr = *F.pyramid;
+  const Eigen::Vector3d Ow = kf->center();
+  for (const MapPointPtr& mp0 : points) {
+    MapPointPtr mp = mp0;
+    if (!mp || mp->bad || mp->descriptor.empty() || mp->inKeyFrame(kf.get())) continue;
+    const Eigen::Vector3d pc = F.T_cw * mp->Xw;
+    if (!(pc.z() > 0)) continue;
+    const Eigen::Vector2d uv = F.cam.project(pc);
+    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
+      continue;
+    const double ur = uv.x() - F.cam.bf / pc.z();
+    const Eigen::Vector3d PO = mp->Xw - Ow;
+    const double d = PO.norm();
+    if (d < 0.8 * mp->min_dist || d > 1.2 * mp->max_dist) continue;
+    if (PO.dot(mp->normal) < 0.5 * d) continue;
+    const int level = mp->predictScale(d, pyr.n_levels, pyr.log_scale_factor);
+    const double radius = th * pyr.scale[level];
+    int best = 256, best_idx = -1;
+    for (size_t j : F.featuresInArea(uv.x(), uv.y(), radius)) {
+      const cv::KeyPoint& kp = F.kps[j];
+      if (kp.octave < level - 1 || kp.octave > level) continue;
+      const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
+      double e2 = ex * ex + ey * ey;
+      double chi = 5.99;
+      if (F.right_u[j] >= 0) {
+        const double er = ur - F.right_u[j];
+        e2 += er * er;
+        chi = 7.8;
+      }
+      if (e2 * pyr.inv_sigma2[kp.octave] > chi) continue;
+      const int dd = dist(mp->descriptor, F.descriptors, static_cast<int>(j));
+      if (dd < best) {
+        best = dd;
+        best_idx = static_cast<int>(j);
+      }
+    }
+    if (best_idx < 0 || best > kThLow) continue;
+    MapPointPtr in_kf = F.points[best_idx];
+    if (in_kf && !in_kf->bad) {
+      if (in_kf->numObservations() > mp->numObservations()) map.replaceMapPoint(mp, in_kf);
+      else map.replaceMapPoint(in_kf, mp);
+    } else {
+      Map::addObservation(mp, kf, best_idx);
+    }
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace matcher
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,62 @@
+#include "yolo_slam/slam/options.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+
+namespace yolo_slam {
+namespace slam {
+
+namespace {
+int positiveInt(const Config& cfg, const std::string& key, int def, int min_value) {
+  int v = cfg.getInt(key, def);
+  if (v < min_value)
+    throw Error(cfg.path() + ": key '" + key + "' must be >= " + std::to_string(min_value) +
+                " (got " + std::to_string(v) + ")");
+  return v;
+}
+double rangeDouble(const Config& cfg, const std::string& key, double def, double lo, double hi) {
+  double v = cfg.getDouble(key, def);
+  if (!(v >= lo && v <= hi))
+    throw Error(cfg.path() + ": key '" + key + "' must be in [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "] (got " + std::to_string(v) + ")");
+  return v;
+}
+}  // namespace
+
+TrackingOptions TrackingOptions::load(const Config& cfg) {
+  TrackingOptions o;
+  o.init_min_keypoints = positiveInt(cfg, "Tracking.initMinKeyPoints", o.init_min_keypoints, 10);
+  o.motion_window = positiveInt(cfg, "Tracking.motionWindow", o.motion_window, 1);
+  o.local_window = positiveInt(cfg, "Tracking.localWindow", o.local_window, 1);
+  o.min_inliers = positiveInt(cfg, "Tracking.minInliers", o.min_inliers, 6);
+  o.max_frames_between_kf = positiveInt(cfg, "Tracking.maxFrames", o.max_frames_between_kf, 0);
+  o.min_frames_between_kf = positiveInt(cfg, "Tracking.minFrames", o.min_frames_between_kf, 0);
+  o.ref_ratio = rangeDouble(cfg, "Tracking.refRatio", o.ref_ratio, 0.0, 1.0);
+  o.close_tracked_max = positiveInt(cfg, "Tracking.closeTrackedMax", o.close_tracked_max, 0);
+  o.close_untracked_min = positiveInt(cfg, "Tracking.closeUntrackedMin", o.close_untracked_min, 0);
+  o.lost_reset_frames = positiveInt(cfg, "Tracking.lostResetFrames", o.lost_reset_frames, 1);
+  o.lost_reset_max_keyframes = positiveInt(cfg, "Tracking.lostResetMaxKeyFrames", o.lost_reset_max_keyframes, 0);
+  o.vo_points = positiveInt(cfg, "Tracking.voPoints", o.vo_points, 0);
+  o.max_stamp_gap = rangeDouble(cfg, "Tracking.maxStampGap", o.max_stamp_gap, 1e-3, 1e6);
+  return o;
+}
+
+LocalMappingOptions LocalMappingOptions::load(const Config& cfg) {
+  LocalMappingOptions o;
+  o.triangulation_neighbours = positiveInt(cfg, "LocalMapping.triangulationNeighbours", o.triangulation_neighbours, 1);
+  o.fuse_neighbours = positiveInt(cfg, "LocalMapping.fuseNeighbours", o.fuse_neighbours, 1);
+  o.culling_redundancy = rangeDouble(cfg, "LocalMapping.cullingRedundancy", o.culling_redundancy, 0.0, 1.0);
+  o.local_ba = cfg.getBool("LocalMapping.localBA", o.local_ba);
+  o.queue_size = positiveInt(cfg, "LocalMapping.queueSize", o.queue_size, 1);
+  return o;
+}
+
+SlamOptions SlamOptions::load(const Config& cfg) {
+  SlamOptions o;
+  o.tracking = TrackingOptions::load(cfg);
+  o.mapping = LocalMappingOptions::load(cfg);
+  return o;
+}
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,271 @@
+#include "yolo_slam/slam/system.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/json.h"
+#include "yolo_slam/common/timing.h"
+#include "yolo_slam/features/frame_builder.h"
+#include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/screening/screener.h"
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/local_mapping.h"
+#include "yolo_slam/slam/map.h"
+#include "yolo_slam/slam/map_point.h"
+#include "yolo_slam/slam/tracking.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <unordered_map>
+
+namespace yolo_slam {
+namespace slam {
+
+SystemOptions SystemOptions::load(const Config& cfg) {
+  SystemOptions o;
+  o.orb = features::OrbOptions::load(cfg);
+  o.screening = screening::ScreeningOptions::load(cfg);
+  o.slam = SlamOptions::load(cfg);
+  return o;
+}
+
+System::System(const CameraModel& cam, const Config& cfg,
+               std::shared_ptr<const vocabulary::Vocabulary> vocabulary)
+    : System(cam, SystemOptions::load(cfg), std::move(vocabulary)) {}
+
+System::System(const CameraModel& cam, const SystemOptions& options,
+               std::shared_ptr<const vocabulary::Vocabulary> vocabulary)
+    : cam_(cam), opt_(options.slam), voc_(std::move(vocabulary)) {
+  const features::OrbOptions& orb_opt = options.orb;
+  orb_ = std::make_unique<features::OrbExtractor>(orb_opt);
+  screener_ = std::make_unique<screening::Screener>(options.screening);
+  auto pyr = std::make_shared<ScalePyramid>(ScalePyramid::make(orb_opt.n_levels, orb_opt.scale_factor));
+  map_ = std::make_unique<Map>();
+  mapper_ = std::make_unique<LocalMapping>(*map_, cam_, opt_.mapping, voc_);
+  tracker_ = std::make_unique<Tracking>(cam_, opt_.tracking, *map_, mapper_.get(), voc_, pyr);
+  mapper_->start();
+}
+
+System::~System() { shutdown(); }
+
+void System::shutdown() {
+  std::lock_guard<std::mutex> lk(track_mutex_);
+  if (shut_down_) return;
+  shut_down_ = true;
+  mapper_->stop();
+}
+
+namespace {
+bool validDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
+  if (depth.empty()) return false;
+  if (depth.type() != CV_32FC1 || depth.size() != image.size()) {
+    std::fprintf(stderr, "warning: frame %.6f: depth image %dx%d type %d does not match the %dx%d "
+                 "colour image (need CV_32FC1 metres); frame tracked without depth\n",
+                 stamp, depth.cols, depth.rows, depth.type(), image.cols, image.rows);
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                              const detection::Boxes& boxes) {
+  if (image.empty()) {
+    std::fprintf(stderr, "warning: frame %.6f: empty image; frame reported lost\n", stamp);
+    features::FeatureFrame empty;
+    empty.stamp = stamp;
+    return trackFeatures(empty);
+  }
+  cv::Mat depth;
+  if (validDepth(depth_m, image, stamp)) {
+    depth = depth_m.clone();
+    cv::patchNaNs(depth, 0.0);  // NaN = invalid
+    cv::Mat bad = (depth != depth) | (depth == std::numeric_limits<float>::infinity());
+    depth.setTo(0.f, bad);
+  }
+  features::FeatureFrame ff;
+  Stopwatch sw;
+  try {
+    ff = features::buildFeatureFrame(*orb_, cam_, image, depth, stamp);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "warning: frame %.6f: %s; frame reported lost\n", stamp, e.what());
+    ff = features::FeatureFrame();
+    ff.stamp = stamp;
+  }
+  const double extraction_ms = sw.ms();
+  sw.restart();
+  screening::ScreeningStats ss = screener_->screen(ff, boxes);
+  const double screening_ms = sw.ms();
+  {
+    std::lock_guard<std::mutex> lk(stats_mutex_);
+    stats_.extraction_ms.push_back(extraction_ms);
+    stats_.screening_ms.push_back(screening_ms);
+    stats_.keypoints_in_boxes += ss.in_boxes;
+    stats_.keypoints_kept += ss.kept;
+    stats_.keypoints_dropped += ss.dropped;
+  }
+  return trackFeatures(ff);
+}
+
+TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  TrackResult res;
+  if (shut_down_) return res;
+  Stopwatch sw;
+  bool reset_requested = false;
+  {
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    res = tracker_->track(frame);
+    reset_requested = tracker_->resetRequested();
+  }
+  const double ms = sw.ms();
+  if (res.state == TrackingState::Ok && !res.T_wc.matrix().allFinite()) res.state = TrackingState::Lost;
+  {
+    std::lock_guard<std::mutex> lk(stats_mutex_);
+    stats_.tracking_ms.push_back(ms);
+    ++stats_.frames;
+    if (res.state == TrackingState::Ok) ++stats_.tracked;
+    else ++stats_.lost;
+  }
+  if (reset_requested) {
+    std::fprintf(stderr, "warning: frame %.6f: lost for long with a small map; map reset\n", frame.stamp);
+    resetInternal(true);
+  }
+  return res;
+}
+
+void System::resetInternal(bool keep_trajectory) {
+  // Caller holds track_mutex_. Local mapping must be parked before the map is cleared.
+  mapper_->pause();
+  mapper_->waitUntilPaused();
+  mapper_->clear();
+  {
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    Trajectory kfs;
+    for (const auto& kf : map_->keyframes()) kfs.push_back({kf->f.stamp, kf->Twc()});
+    if (keep_trajectory) {
+      tracker_->freezeKeyFrames(kfs);
+      tracker_->resetKeepTrajectory();
+    } else {
+      tracker_->resetAll();
+    }
+    map_->clear();
+  }
+  {
+    std::lock_guard<std::mutex> lk(stats_mutex_);
+    ++stats_.resets;
+  }
+  if (!localization_only_.load()) mapper_->resume();
+}
+
+void System::reset() {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  if (shut_down_) return;
+  resetInternal(false);
+}
+
+void System::setLocalizationOnly(bool on) {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  localization_only_.store(on);
+  if (on) mapper_->pause();
+  else mapper_->resume();
+  std::lock_guard<std::mutex> ml(map_->update_mutex);
+  tracker_->setLocalizationOnly(on);
+}
+
+bool System::localizationOnly() const { return localization_only_.load(); }
+
+TrackingState System::state() const {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  return tracker_->state();
+}
+
+void System::waitForLocalMapping() { mapper_->waitIdle(); }
+
+void System::recordDetectionTime(double ms) {
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  stats_.detection_ms.push_back(ms);
+}
+
+const features::OrbExtractor& System::extractor() const { return *orb_; }
+const screening::Screener& System::screener() const { return *screener_; }
+
+Trajectory System::cameraTrajectory() const {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  std::lock_guard<std::mutex> ml(map_->update_mutex);
+  return tracker_->trajectory();
+}
+
+Trajectory System::keyframeTrajectory() const {
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  std::lock_guard<std::mutex> ml(map_->update_mutex);
+  Trajectory out = tracker_->frozenKeyFrames();
+  for (const auto& kf : map_->keyframes()) out.push_back({kf->f.stamp, kf->Twc()});
+  return out;
+}
+
+MapSnapshot System::mapSnapshot() const {
+  std::lock_guard<std::mutex> ml(map_->update_mutex);
+  MapSnapshot s;
+  for (const auto& mp : map_->mapPoints())
+    if (!mp->dynamic && mp->Xw.allFinite()) s.points.push_back(mp->Xw);
+  auto kfs = map_->keyframes();
+  std::unordered_map<long, int> index;
+  for (const auto& kf : kfs) {
+    index[kf->id] = static_cast<int>(s.keyframes.size());
+    s.keyframes.push_back({kf->f.stamp, kf->Twc()});
+  }
+  for (const auto& kf : kfs) {
+    for (const auto& c : kf->connections) {
+      if (c.first->id <= kf->id || c.second < 15) continue;
+      auto it = index.find(c.first->id);
+      if (it != index.end()) s.covisibility_edges.emplace_back(index[kf->id], it->second);
+    }
+  }
+  return s;
+}
+
+SystemStats System::stats() const {
+  SystemStats s;
+  {
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    s.keyframes = map_->numKeyFrames();
+    s.map_points = map_->numMapPoints();
+  }
+  std::vector<double> lm = mapper_->timings();
+  size_t culled = mapper_->culledKeyFrames();
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  size_t kf = s.keyframes, mp = s.map_points;
+  s = stats_;
+  s.keyframes = kf;
+  s.map_points = mp;
+  s.local_mapping_ms = std::move(lm);
+  s.keyframes_culled = culled;
+  return s;
+}
+
+std::string System::statsJson() const {
+  SystemStats s = stats();
+  std::ostringstream o;
+  o << "{\n  \"frames\": " << s.frames << ",\n  \"tracked\": " << s.tracked
+    << ",\n  \"lost\": " << s.lost << ",\n  \"keyframes\": " << s.keyframes
+    << ",\n  \"keyframes_culled\": " << s.keyframes_culled
+    << ",\n  \"map_points\": " << s.map_points << ",\n  \"resets\": " << s.resets
+    << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
+    << ", \"dropped\": " << s.keypoints_dropped << "}"
+    << ",\n  \"timings\": {\n    \"extraction\": " << summaryJsonMs(summarize(s.extraction_ms))
+    << ",\n    \"screening\": " << summaryJsonMs(summarize(s.screening_ms))
+    << ",\n    \"tracking\": " << summaryJsonMs(summarize(s.tracking_ms));
+  std::vector<double> et;
+  if (s.extraction_ms.size() == s.tracking_ms.size())
+    for (size_t i = 0; i < s.tracking_ms.size(); ++i) et.push_back(s.extraction_ms[i] + s.tracking_ms[i]);
+  o << ",\n    \"extraction_plus_tracking\": " << summaryJsonMs(summarize(et))
+    << ",\n    \"local_mapping\": " << summaryJsonMs(summarize(s.local_mapping_ms))
+    << ",\n    \"detection\": " << summaryJsonMs(summarize(s.detection_ms)) << "\n  }\n}\n";
+  return o.str();
+}
+
+}  // namespace slam
+}  // namespace yolo_slam

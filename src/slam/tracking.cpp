@@ -1,0 +1,577 @@
+#include "yolo_slam/slam/tracking.h"
+
+#include "yolo_slam/optimization/pose_optimizer.h"
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/local_mapping.h"
+#include "yolo_slam/slam/map.h"
+#include "yolo_slam/slam/map_point.h"
+#include "yolo_slam/slam/matcher.h"
+#include "yolo_slam/vocabulary/vocabulary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+namespace yolo_slam {
+namespace slam {
+
+const char* toString(TrackingState s) {
+  switch (s) {
+    case TrackingState::NotInitialized: return "not_initialized";
+    case TrackingState::Ok: return "ok";
+    case TrackingState::Lost: return "lost";
+  }
+  return "?";
+}
+
+namespace {
+bool finitePose(const Pose& T) { return T.matrix().allFinite(); }
+}  // namespace
+
+Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map, LocalMapping* mapper,
+                   std::shared_ptr<const vocabulary::Vocabulary> vocabulary,
+                   std::shared_ptr<const ScalePyramid> pyramid)
+    : cam_(cam), opt_(opt), map_(map), mapper_(mapper), voc_(std::move(vocabulary)),
+      pyr_(std::move(pyramid)), geom_(FrameGeometry::make(cam)) {
+  max_frames_ = opt_.max_frames_between_kf > 0 ? opt_.max_frames_between_kf
+                                               : std::max(1, static_cast<int>(std::lround(cam_.fps)));
+  min_frames_ = opt_.min_frames_between_kf;
+}
+
+void Tracking::computeBow(Frame& F) const {
+  if (!voc_ || !F.bow.empty() || F.N == 0) return;
+  voc_->transform(F.descriptors, F.bow.bow, F.bow.features, 4);
+}
+
+TrackResult Tracking::track(const features::FeatureFrame& ff) {
+  reset_requested_ = false;
+  ++frames_;
+  Frame F(ff, cam_, geom_, pyr_, next_frame_id_++);
+  TrackResult res;
+
+  // A timestamp that goes backwards or jumps invalidates the constant-velocity prediction.
+  bool stamp_ok = std::isfinite(F.stamp);
+  if (stamp_ok && has_last_stamp_) {
+    const double dt = F.stamp - last_stamp_;
+    if (!(dt > 0) || dt > opt_.max_stamp_gap) {
+      if (has_velocity_)
+        std::fprintf(stderr, "warning: frame %.6f: timestamp jump of %.3f s; motion model reset\n",
+                     F.stamp, dt);
+      has_velocity_ = false;
+    }
+  }
+  if (stamp_ok) {
+    last_stamp_ = F.stamp;
+    has_last_stamp_ = true;
+  }
+
+  if (state_ == TrackingState::NotInitialized) {
+    if (initialize(F)) {
+      state_ = TrackingState::Ok;
+      res.state = TrackingState::Ok;
+      res.T_wc = F.Twc();
+      res.inliers = F.countWithDepth();
+      res.keyframe_inserted = true;
+      ++tracked_;
+      record(F);
+      last_ = F;
+      has_last_ = true;
+      last_good_T_wc_ = F.Twc();
+      has_last_good_ = true;
+    } else {
+      ++lost_;
+      res.state = TrackingState::NotInitialized;
+    }
+    return res;
+  }
+
+  // Points of the last frame may have been fused or culled by local mapping.
+  if (has_last_) {
+    for (auto& p : last_.points) {
+      if (!p) continue;
+      if (p->bad) p = MapPoint::resolve(p);
+    }
+  }
+  updateLastFrame();
+
+  bool ok = false;
+  if (state_ == TrackingState::Ok && has_last_) {
+    if (has_velocity_) ok = trackMotionModel(F);
+    if (!ok && ref_kf_ && !ref_kf_->bad)
+      ok = trackReferenceKeyFrame(F, ref_kf_, last_.T_cw, 10);
+  } else {
+    ok = trackWhenLost(F);
+  }
+  if (ok) ok = trackLocalMap(F);
+  if (ok && !finitePose(F.T_cw)) ok = false;
+
+  if (ok) {
+    failures_in_row_ = 0;
+    lost_frames_in_row_ = 0;
+    state_ = TrackingState::Ok;
+    if (has_last_) {
+      velocity_ = F.T_cw * last_.T_cw.inverse();
+      has_velocity_ = finitePose(velocity_);
+    }
+    // Drop associations to temporary visual-odometry points.
+    for (int i = 0; i < F.N; ++i) {
+      if (F.points[i] && F.points[i]->numObservations() < 1) {
+        F.points[i].reset();
+        F.outlier[i] = false;
+      }
+    }
+    temporary_points_.clear();
+    if (!localization_only_ && needNewKeyFrame(F)) {
+      createNewKeyFrame(F);
+      res.keyframe_inserted = true;
+    }
+    // Outliers are not carried to the next frame (they stayed in the keyframe if one was made).
+    for (int i = 0; i < F.N; ++i)
+      if (F.points[i] && F.outlier[i]) F.points[i].reset();
+    ++tracked_;
+    res.state = TrackingState::Ok;
+    res.T_wc = F.Twc();
+    res.inliers = inliers_;
+    record(F);
+    last_ = F;
+    has_last_ = true;
+    last_good_T_wc_ = F.Twc();
+    has_last_good_ = true;
+  } else {
+    temporary_points_.clear();
+    ++lost_;
+    ++failures_in_row_;
+    ++lost_frames_in_row_;
+    res.state = TrackingState::Lost;
+    res.inliers = inliers_;
+    // One bad frame (blur, a glitch) is skipped; two in a row mean lost (the velocity is
+    // no longer trustworthy).
+    if (failures_in_row_ >= 2 || state_ == TrackingState::Lost) {
+      state_ = TrackingState::Lost;
+      has_velocity_ = false;
+    }
+    if (state_ == TrackingState::Lost && lost_frames_in_row_ >= opt_.lost_reset_frames &&
+        static_cast<int>(map_.numKeyFrames()) <= opt_.lost_reset_max_keyframes && !localization_only_) {
+      reset_requested_ = true;
+    }
+  }
+  return res;
+}
+
+bool Tracking::initialize(Frame& F) {
+  if (F.countWithDepth() < opt_.init_min_keypoints) return false;
+  F.setPose(has_last_good_ ? last_good_T_wc_.inverse() : Pose::Identity());
+  auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
+  computeBow(kf->f);
+  map_.addKeyFrame(kf);
+  for (int i = 0; i < F.N; ++i) {
+    if (F.depth[i] <= 0 || F.dynamic[i]) continue;
+    Eigen::Vector3d Xw;
+    if (!F.unprojectWorld(i, Xw)) continue;
+    auto mp = std::make_shared<MapPoint>(map_.newPointId(), Xw, kf.get(), F.id);
+    Map::addObservation(mp, kf, i);
+    mp->computeDistinctiveDescriptor();
+    mp->updateNormalAndDepth();
+    map_.addMapPoint(mp);
+    F.points[i] = mp;
+  }
+  if (mapper_) mapper_->insertKeyFrame(kf);
+  ref_kf_ = kf;
+  last_kf_ = kf;
+  last_kf_frame_id_ = F.id;
+  local_kfs_ = {kf};
+  local_points_ = kf->mapPoints();
+  has_velocity_ = false;
+  failures_in_row_ = 0;
+  return true;
+}
+
+void Tracking::updateLastFrame() {
+  if (!has_last_ || !last_ref_ ) return;
+  // The reference keyframe may have been refined by local BA since.
+  KeyFramePtr ref = last_ref_;
+  Pose T_rr = Pose::Identity();
+  while (ref && ref->bad) {
+    T_rr = T_rr * ref->T_cp;  // T_{ref_old, parent}
+    ref = ref->parent;
+  }
+  if (ref) last_.setPose(T_lr_ * T_rr * ref->Tcw());
+  // ORB-SLAM2 creates temporary close points in the last frame only in localization mode,
+  // where no keyframes (and so no new map points) are made.
+  if (!localization_only_ || last_kf_frame_id_ == last_.id) return;
+  std::vector<std::pair<float, int>> by_depth;
+  for (int i = 0; i < last_.N; ++i)
+    if (last_.depth[i] > 0 && !last_.dynamic[i]) by_depth.emplace_back(last_.depth[i], i);
+  std::sort(by_depth.begin(), by_depth.end());
+  int n = 0;
+  for (const auto& e : by_depth) {
+    const int i = e.second;
+    const MapPointPtr& mp = last_.points[i];
+    if (!mp || mp->numObservations() < 1) {
+      Eigen::Vector3d Xw;
+      if (!last_.unprojectWorld(i, Xw)) continue;
+      auto tmp = std::make_shared<MapPoint>(-1, Xw, nullptr, last_.id);
+      tmp->descriptor = last_.descriptors.row(i).clone();
+      const double d = (Xw - last_.cameraCenter()).norm();
+      tmp->max_dist = d * pyr_->scale[last_.kps[i].octave];
+      tmp->min_dist = tmp->max_dist / pyr_->scale[pyr_->n_levels - 1];
+      tmp->normal = (Xw - last_.cameraCenter()).normalized();
+      last_.points[i] = tmp;
+      temporary_points_.push_back(tmp);
+    }
+    ++n;
+    if (e.first > cam_.closeDepth() && n > opt_.vo_points) break;
+  }
+}
+
+int Tracking::optimizePose(Frame& F) {
+  std::vector<optimization::PoseObservation> obs;
+  std::vector<int> idx;
+  for (int i = 0; i < F.N; ++i) {
+    const MapPointPtr& mp = F.points[i];
+    if (!mp || F.dynamic[i]) continue;
+    optimization::PoseObservation o;
+    o.Xw = mp->Xw;
+    o.uv = Eigen::Vector2d(F.kps[i].pt.x, F.kps[i].pt.y);
+    o.u_right = F.right_u[i] >= 0 ? F.right_u[i] : -1.0;
+    o.inv_sigma2 = pyr_->inv_sigma2[F.kps[i].octave];
+    obs.push_back(o);
+    idx.push_back(i);
+  }
+  if (obs.size() < 3) return 0;
+  std::vector<bool> is_outlier(obs.size(), false);
+  Pose T = F.T_cw;
+  int inl = optimization::optimizePose(cam_, T, obs, is_outlier);
+  if (!finitePose(T)) return 0;
+  F.setPose(T);
+  for (size_t k = 0; k < idx.size(); ++k) F.outlier[idx[k]] = is_outlier[k];
+  return inl;
+}
+
+bool Tracking::trackMotionModel(Frame& F) {
+  F.setPose(velocity_ * last_.T_cw);
+  std::fill(F.points.begin(), F.points.end(), nullptr);
+  int n = matcher::searchLastFrame(F, last_, opt_.motion_window);
+  if (n < 20) {
+    std::fill(F.points.begin(), F.points.end(), nullptr);
+    n = matcher::searchLastFrame(F, last_, 2.0 * opt_.motion_window);
+  }
+  if (n < 20) return false;
+  optimizePose(F);
+  int n_map = 0;
+  for (int i = 0; i < F.N; ++i) {
+    if (!F.points[i]) continue;
+    if (F.outlier[i]) {
+      F.points[i]->last_seen_frame = F.id;
+      F.points[i].reset();
+      F.outlier[i] = false;
+    } else if (F.points[i]->numObservations() > 0) {
+      ++n_map;
+    }
+  }
+  if (localization_only_) return n_map >= 10 || n >= 20;
+  return n_map >= 10;
+}
+
+bool Tracking::trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior,
+                                      int min_inliers) {
+  std::fill(F.points.begin(), F.points.end(), nullptr);
+  std::fill(F.outlier.begin(), F.outlier.end(), false);
+  F.setPose(prior);
+  int n = 0;
+  if (voc_) {
+    computeBow(F);
+    if (kf->f.bow.empty()) computeBow(kf->f);
+    n = matcher::searchByBow(*kf, F, 0.7);
+  }
+  if (n < 15) {
+    // Without BoW (or when it finds too little): projection of the keyframe's points with the
+    // prior pose, widening the window once.
+    for (double th : {5.0, 10.0}) {
+      std::fill(F.points.begin(), F.points.end(), nullptr);
+      std::vector<matcher::Projection> proj;
+      for (const auto& mp : kf->mapPoints()) {
+        if (mp->dynamic) continue;
+        matcher::Projection p;
+        if (matcher::projectInFrame(F, mp, 0.0, p)) proj.push_back(p);
+      }
+      n = matcher::searchProjections(F, proj, th, 0.9);
+      if (n >= 20) break;
+    }
+  }
+  if (n < 15) return false;
+  optimizePose(F);
+  int n_map = 0;
+  for (int i = 0; i < F.N; ++i) {
+    if (!F.points[i]) continue;
+    if (F.outlier[i]) {
+      F.points[i]->last_seen_frame = F.id;
+      F.points[i].reset();
+      F.outlier[i] = false;
+    } else if (F.points[i]->numObservations() > 0) {
+      ++n_map;
+    }
+  }
+  return n_map >= min_inliers;
+}
+
+bool Tracking::trackWhenLost(Frame& F) {
+  // No relocalisation yet: try the last reference keyframe and its covisible keyframes with
+  // the last good pose as prior.
+  if (!has_last_good_) return false;
+  std::vector<KeyFramePtr> cands;
+  KeyFramePtr ref = ref_kf_;
+  while (ref && ref->bad) ref = ref->parent;
+  if (ref) {
+    cands.push_back(ref);
+    for (const auto& k : ref->bestCovisibles(10)) cands.push_back(k);
+  }
+  const Pose prior = last_good_T_wc_.inverse();
+  for (const auto& kf : cands) {
+    if (kf->bad) continue;
+    if (trackReferenceKeyFrame(F, kf, prior, 30)) {
+      ref_kf_ = kf;
+      return true;
+    }
+  }
+  return false;
+}
+
+void Tracking::updateLocalMap(Frame& F) {
+  // Local keyframes: those sharing points with the frame, plus their best covisibles,
+  // a child and the parent (ORB-SLAM2 UpdateLocalKeyFrames).
+  std::map<KeyFramePtr, int, ById> counter;
+  for (int i = 0; i < F.N; ++i) {
+    MapPointPtr& mp = F.points[i];
+    if (!mp) continue;
+    if (mp->bad) {
+      mp.reset();
+      continue;
+    }
+    for (const auto& o : mp->observations) counter[o.first]++;
+  }
+  if (counter.empty()) return;
+  local_kfs_.clear();
+  std::set<long> in_local;
+  int max_count = 0;
+  KeyFramePtr best;
+  for (const auto& c : counter) {
+    if (c.first->bad) continue;
+    if (c.second > max_count) {
+      max_count = c.second;
+      best = c.first;
+    }
+    local_kfs_.push_back(c.first);
+    in_local.insert(c.first->id);
+  }
+  const size_t n_direct = local_kfs_.size();
+  for (size_t k = 0; k < n_direct && local_kfs_.size() < 80; ++k) {
+    KeyFramePtr kf = local_kfs_[k];
+    for (const auto& nb : kf->bestCovisibles(10)) {
+      if (!nb->bad && in_local.insert(nb->id).second) {
+        local_kfs_.push_back(nb);
+        break;
+      }
+    }
+    for (KeyFrame* child : kf->children) {
+      if (!child->bad && in_local.insert(child->id).second) {
+        local_kfs_.push_back(child->self());
+        break;
+      }
+    }
+    if (kf->parent && !kf->parent->bad && in_local.insert(kf->parent->id).second)
+      local_kfs_.push_back(kf->parent);
+  }
+  if (best) ref_kf_ = best;
+
+  local_points_.clear();
+  for (const auto& kf : local_kfs_) {
+    for (const auto& mp : kf->f.points) {
+      if (!mp || mp->bad || mp->dynamic || mp->local_ref_frame == F.id) continue;
+      mp->local_ref_frame = F.id;
+      local_points_.push_back(mp);
+    }
+  }
+}
+
+void Tracking::searchLocalPoints(Frame& F) {
+  for (int i = 0; i < F.N; ++i) {
+    MapPointPtr& mp = F.points[i];
+    if (!mp) continue;
+    if (mp->bad) {
+      mp.reset();
+      continue;
+    }
+    mp->visible++;
+    mp->last_seen_frame = F.id;
+  }
+  std::vector<matcher::Projection> proj;
+  for (const auto& mp : local_points_) {
+    if (mp->last_seen_frame == F.id || mp->bad) continue;
+    matcher::Projection p;
+    if (matcher::projectInFrame(F, mp, 0.5, p)) {
+      mp->visible++;
+      proj.push_back(p);
+    }
+  }
+  if (proj.empty()) return;
+  dynamic_hits_.clear();
+  matcher::searchProjections(F, proj, opt_.local_window, 0.8, &dynamic_hits_);
+}
+
+bool Tracking::trackLocalMap(Frame& F) {
+  updateLocalMap(F);
+  searchLocalPoints(F);
+  optimizePose(F);
+  inliers_ = 0;
+  for (int i = 0; i < F.N; ++i) {
+    const MapPointPtr& mp = F.points[i];
+    if (!mp) continue;
+    if (!F.outlier[i]) {
+      mp->found++;
+      if (localization_only_ || mp->numObservations() > 0) ++inliers_;
+    } else {
+      // RGB-D: outliers are dropped right away (ORB-SLAM2 does so for stereo).
+      F.points[i].reset();
+    }
+  }
+  return inliers_ >= opt_.min_inliers;
+}
+
+bool Tracking::needNewKeyFrame(const Frame& F) const {
+  if (!mapper_ || mapper_->paused()) return false;
+  const int n_kfs = static_cast<int>(map_.numKeyFrames());
+  const int min_obs = n_kfs <= 2 ? 2 : 3;
+  KeyFramePtr ref = ref_kf_;
+  const int ref_matches = ref && !ref->bad ? ref->trackedMapPoints(min_obs) : 0;
+  const bool idle = mapper_->acceptsKeyFrames();
+  int tracked_close = 0, untracked_close = 0;
+  const double close = cam_.closeDepth();
+  for (int i = 0; i < F.N; ++i) {
+    if (F.dynamic[i] || F.depth[i] <= 0 || F.depth[i] >= close) continue;
+    if (F.points[i] && !F.outlier[i]) ++tracked_close;
+    else ++untracked_close;
+  }
+  const bool need_close = tracked_close < opt_.close_tracked_max && untracked_close > opt_.close_untracked_min;
+  const double ratio = n_kfs < 2 ? 0.4 : opt_.ref_ratio;
+  const bool c1a = F.id >= last_kf_frame_id_ + max_frames_;
+  const bool c1b = F.id >= last_kf_frame_id_ + min_frames_ && idle;
+  const bool c1c = inliers_ < ref_matches * 0.25 || need_close;
+  const bool c2 = (inliers_ < ref_matches * ratio || need_close) && inliers_ > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  if (idle) return true;
+  mapper_->interruptBA();
+  return mapper_->queued() < static_cast<size_t>(mapper_->queueCapacity());
+}
+
+void Tracking::createNewKeyFrame(Frame& F) {
+  auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
+  computeBow(kf->f);
+  ref_kf_ = kf;
+  // Close points with depth become map points right away (ORB-SLAM2 CreateNewKeyFrame):
+  // the closest ones first, all those nearer than ThDepth, at least 100.
+  std::vector<std::pair<float, int>> by_depth;
+  for (int i = 0; i < F.N; ++i)
+    if (F.depth[i] > 0 && !F.dynamic[i]) by_depth.emplace_back(F.depth[i], i);
+  std::sort(by_depth.begin(), by_depth.end());
+  int n = 0;
+  for (const auto& e : by_depth) {
+    const int i = e.second;
+    const MapPointPtr& cur = kf->f.points[i];
+    if (!cur || cur->numObservations() < 1) {
+      Eigen::Vector3d Xw;
+      if (!F.unprojectWorld(i, Xw)) continue;
+      auto mp = std::make_shared<MapPoint>(map_.newPointId(), Xw, kf.get(), F.id);
+      Map::addObservation(mp, kf, i);
+      mp->computeDistinctiveDescriptor();
+      mp->updateNormalAndDepth();
+      map_.addMapPoint(mp);
+      F.points[i] = mp;
+      F.outlier[i] = false;
+    }
+    ++n;
+    if (e.first > cam_.closeDepth() && n > 100) break;
+  }
+  // Map points that now project onto a dynamic keypoint are marked in this keyframe: they are
+  // on something that moves and are no longer used for tracking.
+  for (const auto& mp : dynamic_hits_)
+    if (mp && !mp->bad) mp->dynamic = true;
+  dynamic_hits_.clear();
+  mapper_->insertKeyFrame(kf);
+  last_kf_ = kf;
+  last_kf_frame_id_ = F.id;
+}
+
+void Tracking::record(const Frame& F) {
+  FrameRecord r;
+  r.stamp = F.stamp;
+  r.T_wc = F.Twc();
+  if (ref_kf_ && !ref_kf_->bad) {
+    r.ref = ref_kf_;
+    r.T_cr = F.T_cw * ref_kf_->Twc();
+  }
+  records_.push_back(r);
+  last_ref_ = r.ref;
+  T_lr_ = r.T_cr;
+}
+
+Trajectory Tracking::trajectory() const {
+  Trajectory out;
+  out.reserve(records_.size());
+  for (const auto& r : records_) {
+    StampedPose sp;
+    sp.stamp = r.stamp;
+    sp.T_wc = r.T_wc;
+    if (r.ref) {
+      // Follow erased keyframes to their parents (their pose relative to the parent is kept).
+      KeyFramePtr ref = r.ref;
+      Pose T_rr = Pose::Identity();
+      while (ref && ref->bad) {
+        T_rr = T_rr * ref->T_cp;
+        ref = ref->parent;
+      }
+      if (ref) sp.T_wc = (r.T_cr * T_rr * ref->Tcw()).inverse();
+    }
+    if (finitePose(sp.T_wc)) out.push_back(sp);
+  }
+  return out;
+}
+
+void Tracking::resetKeepTrajectory() {
+  // Freeze the trajectory so far as absolute poses, then forget the old map.
+  Trajectory t = trajectory();
+  records_.clear();
+  for (const auto& sp : t) {
+    FrameRecord r;
+    r.stamp = sp.stamp;
+    r.T_wc = sp.T_wc;
+    records_.push_back(r);
+  }
+  state_ = TrackingState::NotInitialized;
+  has_last_ = false;
+  last_ = Frame();
+  ref_kf_.reset();
+  last_kf_.reset();
+  last_ref_.reset();
+  last_kf_frame_id_ = -1;
+  has_velocity_ = false;
+  failures_in_row_ = 0;
+  lost_frames_in_row_ = 0;
+  local_kfs_.clear();
+  local_points_.clear();
+  dynamic_hits_.clear();
+  temporary_points_.clear();
+  ++resets_;
+}
+
+void Tracking::resetAll() {
+  resetKeepTrajectory();
+  records_.clear();
+  frozen_keyframes_.clear();
+  has_last_good_ = false;
+  has_last_stamp_ = false;
+}
+
+}  // namespace slam
+}  // namespace yolo_slam

@@ -1,0 +1,334 @@
+// yolo_slam_run: the offline runner (ORB-SLAM2's rgbd_tum equivalent). Reads a TUM RGB-D
+// folder, runs detection (own thread, one frame ahead), screening and SLAM frame by frame and
+// writes CameraTrajectory.txt, KeyFrameTrajectory.txt and stats.json.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/json.h"
+#include "yolo_slam/common/paths.h"
+#include "yolo_slam/common/progress.h"
+#include "yolo_slam/common/timing.h"
+#include "yolo_slam/detection/detector.h"
+#include "yolo_slam/eval/ate.h"
+#include "yolo_slam/io/text_table.h"
+#include "yolo_slam/io/trajectory.h"
+#include "yolo_slam/io/tum_sequence.h"
+#include "yolo_slam/screening/screener.h"
+#include "yolo_slam/slam/system.h"
+#include "yolo_slam/vocabulary/vocabulary.h"
+
+#include <opencv2/core.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <future>
+#include <map>
+#include <sstream>
+#include <string>
+#include <sys/stat.h>
+#include <thread>
+
+using namespace yolo_slam;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void onSignal(int) { g_stop = 1; }
+
+const char* kUsage =
+    "usage: yolo_slam_run --sequence DIR --config YAML --out DIR [--max-frames N] [--realtime]\n"
+    "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
+    "                     [--vocabulary FILE] [--boxes-from-gt]\n"
+    "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
+    "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
+    "OUT/stats.json. Ctrl-C stops at the next frame and still writes everything.\n"
+    "  --max-frames N     only the first N frames\n"
+    "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
+    "  --dynamic-mode M   override Screening.mode of the config\n"
+    "  --model DIR        detector model (folder, .cfg or .onnx); default Detector.model\n"
+    "  --vocabulary FILE  ORB vocabulary (binary or ORBvoc.txt) for BoW matching\n"
+    "  --boxes-from-gt    person boxes from the sequence's boxes.txt (synthetic ground truth)\n"
+    "                     instead of running the detector\n";
+
+struct Args {
+  std::string sequence, config, out, model, vocabulary, dynamic_mode;
+  long max_frames = -1;
+  bool realtime = false, boxes_from_gt = false;
+};
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  auto need = [&](int& i, const std::string& flag) -> std::string {
+    if (i + 1 >= argc) throw Error("missing value after " + flag + "\n" + kUsage);
+    return argv[++i];
+  };
+  for (int i = 1; i < argc; ++i) {
+    std::string s = argv[i];
+    if (s == "--sequence") a.sequence = need(i, s);
+    else if (s == "--config") a.config = need(i, s);
+    else if (s == "--out") a.out = need(i, s);
+    else if (s == "--model") a.model = need(i, s);
+    else if (s == "--vocabulary") a.vocabulary = need(i, s);
+    else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
+    else if (s == "--realtime") a.realtime = true;
+    else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
+    else if (s == "--max-frames") {
+      std::string v = need(i, s);
+      char* end = nullptr;
+      a.max_frames = std::strtol(v.c_str(), &end, 10);
+      if (!end || *end || a.max_frames <= 0) throw Error("--max-frames must be a positive integer (got '" + v + "')");
+    } else if (s == "-h" || s == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else {
+      throw Error("unknown option '" + s + "'; see --help");
+    }
+  }
+  if (a.sequence.empty() || a.config.empty() || a.out.empty())
+    throw Error(std::string("--sequence, --config and --out are required\n") + kUsage);
+  return a;
+}
+
+// boxes.txt of a synthetic sequence: "rgb_stamp id class x1 y1 x2 y2 visible_fraction".
+// Person boxes only (what the detector is asked for), keyed by the stamp in microseconds.
+std::map<long long, detection::Boxes> readGtBoxes(const std::string& path) {
+  if (!fileExists(path))
+    throw Error(path + ": not found; --boxes-from-gt needs a synthetic sequence (yolo_slam_synth writes boxes.txt)");
+  std::map<long long, detection::Boxes> out;
+  for (const auto& row : io::readTextTable(path)) {
+    if (row.fields.size() < 7) io::throwAtLine(path, row.line, "expected 'stamp id class x1 y1 x2 y2 [visible]'");
+    const double stamp = io::parseFiniteDouble(row.fields[0], path, row.line, "stamp");
+    if (row.fields[2] != "person") continue;
+    double c[4];
+    for (int k = 0; k < 4; ++k) c[k] = io::parseFiniteDouble(row.fields[3 + k], path, row.line, "box corner");
+    detection::Box b;
+    b.class_id = 0;
+    b.label = "person";
+    b.score = 1.f;
+    b.rect = cv::Rect2f(static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2] - c[0]),
+                        static_cast<float>(c[3] - c[1]));
+    out[std::llround(stamp * 1e6)].push_back(b);
+  }
+  return out;
+}
+
+// One frame as prepared by the worker: images, boxes and what went wrong.
+struct Prepared {
+  size_t index = 0;
+  double stamp = 0;
+  cv::Mat bgr, depth;
+  detection::Boxes boxes;
+  bool has_image = false;
+  std::string warning;
+  double detection_ms = -1;
+};
+
+void makeDirs(const std::string& dir) {
+  std::string cur;
+  std::stringstream ss(dir);
+  std::string part;
+  if (!dir.empty() && dir[0] == '/') cur = "/";
+  while (std::getline(ss, part, '/')) {
+    if (part.empty()) continue;
+    cur += part + "/";
+    ::mkdir(cur.c_str(), 0755);
+  }
+  if (!dirExists(dir)) throw Error(dir + ": cannot create the output folder; check the path and permissions");
+}
+
+std::string summaryField(const char* name, const std::vector<double>& v) {
+  return std::string("    \"") + name + "\": " + summaryJsonMs(summarize(v));
+}
+
+int run(const Args& args) {
+  Config cfg = Config::fromFile(args.config);
+  CameraModel cam = CameraModel::load(cfg);
+  slam::SystemOptions sys_opt = slam::SystemOptions::load(cfg);
+  if (!args.dynamic_mode.empty()) sys_opt.screening.mode = screening::parseDynamicMode(args.dynamic_mode);
+  const screening::DynamicMode mode = sys_opt.screening.mode;
+  const bool needs_boxes = mode == screening::DynamicMode::Detect || mode == screening::DynamicMode::DetectGeometry;
+
+  io::TumSequence seq = io::TumSequence::open(args.sequence);
+  size_t n = seq.size();
+  if (args.max_frames > 0) n = std::min(n, static_cast<size_t>(args.max_frames));
+
+  std::map<long long, detection::Boxes> gt_boxes;
+  std::unique_ptr<detection::Detector> detector;
+  std::string detector_name = "none";
+  if (needs_boxes) {
+    if (args.boxes_from_gt) {
+      gt_boxes = readGtBoxes(joinPath(args.sequence, "boxes.txt"));
+      detector_name = "ground-truth boxes.txt";
+    } else {
+      detection::DetectorOptions dopt = detection::DetectorOptions::load(cfg);
+      if (!args.model.empty()) dopt.model = args.model;
+      detector = detection::makeDetector(dopt);
+      detector_name = dopt.model;
+    }
+  }
+  std::shared_ptr<const vocabulary::Vocabulary> voc;
+  if (!args.vocabulary.empty()) voc = vocabulary::Vocabulary::load(args.vocabulary);
+  makeDirs(args.out);
+
+  std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s\n", n,
+               args.sequence.c_str(), screening::toString(mode).c_str(), detector_name.c_str());
+
+  slam::System system(cam, sys_opt, voc);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+
+  // Worker: loads frame i and detects people in it (the detector is used by one task at a time).
+  auto prepare = [&](size_t i) {
+    Prepared p;
+    p.index = i;
+    p.stamp = seq.frames()[i].rgb_stamp;
+    try {
+      p.bgr = seq.loadRgb(i);
+      p.has_image = !p.bgr.empty();
+    } catch (const std::exception& e) {
+      p.warning = e.what();
+      return p;
+    }
+    try {
+      p.depth = seq.loadDepth(i, cam.depth_map_factor);
+    } catch (const std::exception& e) {
+      p.warning = std::string(e.what()) + " (tracked without depth)";
+      p.depth = cv::Mat();
+    }
+    if (needs_boxes) {
+      if (detector) {
+        Stopwatch sw;
+        try {
+          p.boxes = detector->detect(p.bgr);
+        } catch (const std::exception& e) {
+          p.warning = std::string("detector failed: ") + e.what();
+        }
+        p.detection_ms = sw.ms();
+      } else {
+        auto it = gt_boxes.find(std::llround(p.stamp * 1e6));
+        if (it != gt_boxes.end()) p.boxes = it->second;
+      }
+    }
+    return p;
+  };
+
+  ProgressBar bar("yolo_slam_run", n);
+  std::vector<double> frame_ms;
+  size_t skipped = 0, processed = 0, lost_reports = 0;
+  Stopwatch total;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double stamp0 = n ? seq.frames()[0].rgb_stamp : 0;
+  std::future<Prepared> next;
+  if (n > 0) next = std::async(std::launch::async, prepare, size_t{0});
+  for (size_t i = 0; i < n && !g_stop; ++i) {
+    Stopwatch fsw;
+    Prepared p = next.get();
+    // Detection of frame i+1 overlaps the tracking of frame i.
+    if (i + 1 < n) next = std::async(std::launch::async, prepare, i + 1);
+    if (args.realtime) {
+      const auto due = wall0 + std::chrono::duration<double>(p.stamp - stamp0);
+      std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
+    }
+    if (!p.warning.empty()) std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s\n", i, p.stamp, p.warning.c_str());
+    if (p.detection_ms >= 0) system.recordDetectionTime(p.detection_ms);
+    if (!p.has_image) {
+      ++skipped;
+    } else {
+      slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
+      if (r.state != slam::TrackingState::Ok) ++lost_reports;
+      ++processed;
+    }
+    frame_ms.push_back(fsw.ms());
+    char extra[96];
+    std::snprintf(extra, sizeof extra, "%s, lost %zu", slam::toString(system.state()), lost_reports);
+    bar.update(i + 1, extra);
+  }
+  if (next.valid()) next.wait();
+  bar.finish();
+  const double total_s = total.ms() / 1000.0;
+  if (g_stop) std::fprintf(stderr, "interrupted: stopping after %zu frames and writing the results\n", processed + skipped);
+
+  system.waitForLocalMapping();
+  system.shutdown();
+  Trajectory traj = system.cameraTrajectory();
+  Trajectory kfs = system.keyframeTrajectory();
+  io::writeTrajectory(joinPath(args.out, "CameraTrajectory.txt"), traj);
+  io::writeTrajectory(joinPath(args.out, "KeyFrameTrajectory.txt"), kfs);
+
+  double ate_rmse = NAN;
+  size_t ate_pairs = 0;
+  if (seq.hasGroundTruth() && traj.size() >= 2) {
+    try {
+      eval::AteResult ate = eval::computeAte(seq.groundTruth(), traj);
+      ate_rmse = ate.stats.rmse;
+      ate_pairs = ate.stats.count;
+    } catch (const Error& e) {
+      std::fprintf(stderr, "warning: ATE not computed: %s\n", e.what());
+    }
+  }
+
+  slam::SystemStats s = system.stats();
+  std::ostringstream js;
+  js << "{\n  \"sequence\": \"" << jsonEscape(args.sequence) << "\",\n  \"config\": \"" << jsonEscape(args.config)
+     << "\",\n  \"dynamic_mode\": \"" << screening::toString(mode) << "\",\n  \"boxes\": \""
+     << jsonEscape(detector_name) << "\",\n  \"interrupted\": " << (g_stop ? "true" : "false")
+     << ",\n  \"frames\": " << s.frames << ",\n  \"frames_skipped\": " << skipped
+     << ",\n  \"tracked\": " << s.tracked << ",\n  \"lost\": " << s.lost
+     << ",\n  \"trajectory_poses\": " << traj.size() << ",\n  \"keyframes\": " << s.keyframes
+     << ",\n  \"keyframes_culled\": " << s.keyframes_culled << ",\n  \"map_points\": " << s.map_points
+     << ",\n  \"map_resets\": " << s.resets << ",\n  \"ate_rmse_m\": " << jsonNumber(ate_rmse, 6)
+     << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
+     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 2)
+     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
+     << ", \"dropped\": " << s.keypoints_dropped << "}";
+  std::vector<double> et;
+  for (size_t k = 0; k < s.tracking_ms.size() && k < s.extraction_ms.size(); ++k)
+    et.push_back(s.extraction_ms[k] + s.tracking_ms[k]);
+  js << ",\n  \"timings\": {\n" << summaryField("extraction", s.extraction_ms) << ",\n"
+     << summaryField("screening", s.screening_ms) << ",\n" << summaryField("tracking", s.tracking_ms) << ",\n"
+     << summaryField("extraction_plus_tracking", et) << ",\n"
+     << summaryField("local_mapping", s.local_mapping_ms) << ",\n"
+     << summaryField("detection", s.detection_ms) << ",\n" << summaryField("frame", frame_ms) << "\n  }\n}\n";
+  const std::string stats_path = joinPath(args.out, "stats.json");
+  {
+    std::ofstream f(stats_path + ".tmp");
+    f << js.str();
+    if (!f) throw Error(stats_path + ": cannot write; check the output folder");
+  }
+  if (std::rename((stats_path + ".tmp").c_str(), stats_path.c_str()) != 0)
+    throw Error(stats_path + ": cannot write; check the output folder");
+
+  std::printf("frames %zu, tracked %zu, lost %zu, keyframes %zu, map points %zu\n", s.frames, s.tracked, s.lost,
+              s.keyframes, s.map_points);
+  const auto t = summarize(et);
+  std::printf("extraction+tracking median %.2f ms, p95 %.2f ms; %.1f frames/s overall\n", t.median, t.p95,
+              total_s > 0 ? (processed + skipped) / total_s : 0.0);
+  if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);
+  std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
+  return g_stop ? 130 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArgs(argc, argv));
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    // One line: usage text after the first line is printed separately.
+    auto nl = msg.find('\n');
+    std::fprintf(stderr, "error: %s\n", msg.substr(0, nl).c_str());
+    if (nl != std::string::npos) std::fputs(msg.substr(nl + 1).c_str(), stderr);
+    return 1;
+  } catch (const cv::Exception& e) {
+    std::fprintf(stderr, "error: OpenCV: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
