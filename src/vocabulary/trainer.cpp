@@ -1,0 +1,262 @@
+#include "yolo_slam/vocabulary/trainer.h"
+
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/timing.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <random>
+
+namespace yolo_slam {
+namespace vocabulary {
+namespace {
+
+using Desc = std::array<uint64_t, 4>;
+
+inline int hamming(const Desc& a, const Desc& b) {
+  return __builtin_popcountll(a[0] ^ b[0]) + __builtin_popcountll(a[1] ^ b[1]) +
+         __builtin_popcountll(a[2] ^ b[2]) + __builtin_popcountll(a[3] ^ b[3]);
+}
+
+// Bitwise majority of the members (ties give 1, as DBoW2's ORB mean does).
+Desc majority(const std::vector<Desc>& data, const std::vector<uint32_t>& members) {
+  uint32_t count[256] = {0};
+  for (uint32_t m : members) {
+    const Desc& d = data[m];
+    for (int w = 0; w < 4; ++w) {
+      const uint64_t x = d[w];
+      uint32_t* c = count + 64 * w;
+      for (int b = 0; b < 64; ++b) c[b] += static_cast<uint32_t>((x >> b) & 1u);
+    }
+  }
+  Desc out{0, 0, 0, 0};
+  const size_t n = members.size();
+  for (int i = 0; i < 256; ++i)
+    if (2 * static_cast<size_t>(count[i]) >= n) out[i / 64] |= uint64_t(1) << (i % 64);
+  return out;
+}
+
+struct Work {
+  uint32_t node;
+  int level;
+  std::vector<uint32_t> members;
+};
+
+// k-majority on one node's descriptors; returns the non-empty clusters' centres and members.
+void cluster(const std::vector<Desc>& data, const std::vector<uint32_t>& members, int k,
+             int max_iterations, std::mt19937_64& rng, std::vector<Desc>& centres,
+             std::vector<std::vector<uint32_t>>& groups) {
+  const size_t n = members.size();
+  // k-means++ seeding: next centre drawn with probability proportional to squared distance.
+  centres.clear();
+  centres.push_back(data[members[std::uniform_int_distribution<size_t>(0, n - 1)(rng)]]);
+  std::vector<double> d2(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double d = hamming(data[members[i]], centres[0]);
+    d2[i] = d * d;
+  }
+  while (static_cast<int>(centres.size()) < k) {
+    double total = 0;
+    for (double v : d2) total += v;
+    if (total <= 0) break;  // all remaining descriptors coincide with a centre
+    double r = std::uniform_real_distribution<double>(0.0, total)(rng);
+    size_t pick = n - 1;
+    for (size_t i = 0; i < n; ++i) {
+      r -= d2[i];
+      if (r < 0) {
+        pick = i;
+        break;
+      }
+    }
+    centres.push_back(data[members[pick]]);
+    for (size_t i = 0; i < n; ++i) {
+      const double d = hamming(data[members[i]], centres.back());
+      d2[i] = std::min(d2[i], d * d);
+    }
+  }
+  const size_t kc = centres.size();
+  std::vector<uint32_t> assign(n, 0xffffffffu);
+  for (int it = 0; it < std::max(1, max_iterations); ++it) {
+    bool changed = false;
+    for (size_t i = 0; i < n; ++i) {
+      const Desc& d = data[members[i]];
+      uint32_t best = 0;
+      int best_d = hamming(d, centres[0]);
+      for (size_t c = 1; c < kc; ++c) {
+        const int dc = hamming(d, centres[c]);
+        if (dc < best_d) {
+          best_d = dc;
+          best = static_cast<uint32_t>(c);
+        }
+      }
+      if (assign[i] != best) {
+        assign[i] = best;
+        changed = true;
+      }
+    }
+    groups.assign(kc, {});
+    for (size_t i = 0; i < n; ++i) groups[assign[i]].push_back(members[i]);
+    if (!changed && it > 0) break;
+    for (size_t c = 0; c < kc; ++c)
+      if (!groups[c].empty()) centres[c] = majority(data, groups[c]);
+  }
+  // Drop empty clusters.
+  size_t out = 0;
+  for (size_t c = 0; c < kc; ++c) {
+    if (groups[c].empty()) continue;
+    if (out != c) {
+      centres[out] = centres[c];
+      groups[out] = std::move(groups[c]);
+    }
+    ++out;
+  }
+  centres.resize(out);
+  groups.resize(out);
+}
+
+uint64_t mix(uint64_t x) {  // splitmix64 finaliser: per-node seeds from (seed, node id)
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
+                                            const TrainerOptions& opt, TrainingReport* report,
+                                            const std::function<void(size_t, size_t)>& progress) {
+  if (opt.k < 2 || opt.k > 1000)
+    throw Error("vocabulary training: k must be in 2..1000, got " + std::to_string(opt.k));
+  if (opt.levels < 1 || opt.levels > 12)
+    throw Error("vocabulary training: levels must be in 1..12, got " + std::to_string(opt.levels));
+  std::vector<Desc> data;
+  std::vector<uint32_t> image_of;
+  for (size_t i = 0; i < images.size(); ++i) {
+    const cv::Mat& m = images[i];
+    if (m.empty()) continue;
+    if (m.type() != CV_8UC1 || m.cols != kDescriptorBytes)
+      throw Error("vocabulary training: image " + std::to_string(i) +
+                  " descriptors must be N x 32 CV_8U (ORB)");
+    for (int r = 0; r < m.rows; ++r) {
+      Desc d;
+      std::memcpy(d.data(), m.ptr<uint8_t>(r), kDescriptorBytes);
+      data.push_back(d);
+      image_of.push_back(static_cast<uint32_t>(i));
+    }
+  }
+  if (data.size() < static_cast<size_t>(opt.k))
+    throw Error("vocabulary training: only " + std::to_string(data.size()) +
+                " descriptors, need at least k=" + std::to_string(opt.k) + "; add more images");
+
+  Stopwatch sw;
+  std::vector<uint32_t> parents{0};
+  std::vector<Desc> node_desc{Desc{0, 0, 0, 0}};
+  const size_t total = data.size() * static_cast<size_t>(opt.levels);
+  size_t done = 0;
+  std::deque<Work> queue;
+  {
+    Work root{0, 0, std::vector<uint32_t>(data.size())};
+    for (size_t i = 0; i < data.size(); ++i) root.members[i] = static_cast<uint32_t>(i);
+    queue.push_back(std::move(root));
+  }
+  std::vector<Desc> centres;
+  std::vector<std::vector<uint32_t>> groups;
+  // Breadth-first, so node ids are assigned level by level with each node's children contiguous.
+  while (!queue.empty()) {
+    Work w = std::move(queue.front());
+    queue.pop_front();
+    const size_t remaining_levels = static_cast<size_t>(opt.levels - w.level);
+    if (w.members.size() <= static_cast<size_t>(opt.k)) {
+      // Too few to cluster: each descriptor becomes a leaf (DBoW2 does the same).
+      for (uint32_t m : w.members) {
+        parents.push_back(w.node);
+        node_desc.push_back(data[m]);
+      }
+      done += w.members.size() * remaining_levels;
+    } else {
+      std::mt19937_64 rng(mix(opt.seed ^ mix(w.node)));
+      cluster(data, w.members, opt.k, opt.max_iterations, rng, centres, groups);
+      done += w.members.size();
+      for (size_t c = 0; c < centres.size(); ++c) {
+        const uint32_t id = static_cast<uint32_t>(parents.size());
+        parents.push_back(w.node);
+        node_desc.push_back(centres[c]);
+        if (w.level + 1 < opt.levels && groups[c].size() > 1)
+          queue.push_back(Work{id, w.level + 1, std::move(groups[c])});
+        else
+          done += groups[c].size() * (remaining_levels - 1);
+      }
+    }
+    if (progress) progress(done, total);
+  }
+  const double cluster_s = sw.ms() / 1000.0;
+  sw.restart();
+
+  const size_t n = parents.size();
+  std::vector<uint8_t> desc(n * kDescriptorBytes);
+  for (size_t i = 0; i < n; ++i) std::memcpy(&desc[i * kDescriptorBytes], node_desc[i].data(), kDescriptorBytes);
+  std::vector<double> weights(n, 1.0);
+  auto tree = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, parents, desc,
+                                    weights, {}, "vocabulary training");
+
+  // Words of the training descriptors: per-word descriptor counts and image counts (IDF).
+  std::vector<uint32_t> word_of(data.size());
+  for (size_t i = 0; i < data.size(); ++i)
+    word_of[i] = tree->transform(reinterpret_cast<const uint8_t*>(data[i].data()));
+  const size_t words = tree->size();
+  std::vector<uint32_t> desc_count(words, 0), image_count(words, 0), last_image(words, 0xffffffffu);
+  size_t n_images = 0;
+  for (size_t i = 0; i < data.size(); ++i) {
+    const uint32_t w = word_of[i];
+    ++desc_count[w];
+    if (last_image[w] != image_of[i]) {
+      last_image[w] = image_of[i];
+      ++image_count[w];
+    }
+  }
+  for (const cv::Mat& m : images) n_images += m.empty() ? 0 : 1;
+  if (opt.weighting == Weighting::TfIdf || opt.weighting == Weighting::Idf) {
+    for (size_t w = 0; w < words; ++w) {
+      // As DBoW2: log(N / n_i); words no training image reaches keep weight 0 (ignored).
+      const double idf = image_count[w] > 0
+                             ? std::log(static_cast<double>(n_images) / image_count[w])
+                             : 0.0;
+      weights[tree->wordNode(static_cast<WordId>(w))] = idf;
+    }
+  }
+  // Inner nodes: weight 0 (never used; keeps files comparable with DBoW2's).
+  {
+    std::vector<uint8_t> is_leaf(n, 1);
+    for (size_t i = 1; i < n; ++i) is_leaf[parents[i]] = 0;
+    for (size_t i = 0; i < n; ++i)
+      if (!is_leaf[i]) weights[i] = 0.0;
+  }
+  auto vocab = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, parents, desc,
+                                     weights, {}, "vocabulary training");
+  if (report) {
+    report->images = n_images;
+    report->descriptors = data.size();
+    report->nodes = n;
+    report->words = words;
+    report->capacity = std::pow(static_cast<double>(opt.k), opt.levels);
+    std::vector<double> counts;
+    for (size_t w = 0; w < words; ++w) {
+      if (desc_count[w] > 0) ++report->words_hit;
+      if (image_count[w] >= 2) ++report->words_in_two_images;
+      counts.push_back(desc_count[w]);
+    }
+    const Summary s = summarize(counts);
+    report->mean_descriptors_per_word = s.mean;
+    report->median_descriptors_per_word = s.median;
+    report->cluster_seconds = cluster_s;
+    report->weight_seconds = sw.ms() / 1000.0;
+  }
+  return vocab;
+}
+
+}  // namespace vocabulary
+}  // namespace yolo_slam
