@@ -1,8 +1,11 @@
 // yolo_slam_synth: generates a synthetic dynamic RGB-D sequence in the TUM layout.
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/sim/contact_sheet.h"
 #include "yolo_slam/sim/generator.h"
 #include "yolo_slam/sim/textures.h"
+
+#include <opencv2/imgcodecs.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +21,8 @@ static void usage() {
       "                       [--trajectory static|xyz|rpy|halfsphere|loop|FILE] [--config FILE]\n"
       "                       [--motion-blur] [--no-noise] [--threads N]\n"
       "       yolo_slam_synth --list-presets | --list-textures [--textures DIR]\n"
+      "       yolo_slam_synth --contact-sheet PNG [--preset NAME ...]  (rgb, depth, mask of frames\n"
+      "                       0, 300, 600 of each preset; all presets by default)\n"
       "Writes a TUM-format RGB-D sequence (rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt,\n"
       "associations.txt, camera.yaml) with dynamic ground truth (masks/, boxes.txt).\n"
       "Presets: walking_xyz (default) walking_static walking_rpy walking_half sitting_static\n"
@@ -35,7 +40,8 @@ static long parseInt(const std::string& flag, const std::string& v, long lo) {
 int main(int argc, char** argv) {
   try {
     sim::SynthOptions opt;
-    std::string out, config;
+    std::string out, config, sheet;
+    std::vector<std::string> sheet_presets;
     bool list_presets = false, list_textures = false, blur = false, no_noise = false;
     int threads = -1;
     long seed = -1, frames = -1;
@@ -48,7 +54,8 @@ int main(int argc, char** argv) {
       };
       if (a == "-h" || a == "--help") { usage(); return 0; }
       else if (a == "--out") out = val();
-      else if (a == "--preset") preset = val();
+      else if (a == "--preset") preset = val(), sheet_presets.push_back(preset);
+      else if (a == "--contact-sheet") sheet = val();
       else if (a == "--seed") seed = parseInt(a, val(), 0);
       else if (a == "--frames") frames = parseInt(a, val(), 0);
       else if (a == "--textures") textures = val();
@@ -80,6 +87,14 @@ int main(int argc, char** argv) {
     if (list_textures) {
       std::string dir = opt.textures_dir.empty() ? sim::defaultTextureDir() : opt.textures_dir;
       for (const auto& f : sim::listTextureFiles(dir)) std::printf("%s/%s\n", dir.c_str(), f.c_str());
+      return 0;
+    }
+    if (!sheet.empty()) {
+      if (sheet_presets.empty())
+        for (const auto& p : sim::presets()) sheet_presets.push_back(p.name);
+      cv::Mat img = sim::contactSheet(opt, sheet_presets, {0, 300, 600}, 200);
+      if (!cv::imwrite(sheet, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
+        throw Error("cannot write contact sheet " + sheet + ": check the folder exists and is writable");
       return 0;
     }
     if (out.empty()) throw Error("--out DIR is required (see --help)");
