@@ -1,0 +1,268 @@
+#include "yolo_slam/ros/conversions.h"
+
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/image_encodings.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/io/depth.h"
+
+namespace yolo_slam {
+namespace ros1 {
+
+namespace enc = sensor_msgs::image_encodings;
+
+BoundingBox toMsg(const detection::Box& box) {
+  BoundingBox m;
+  m.class_id = box.class_id;
+  m.label = box.label;
+  m.score = box.score;
+  m.x = box.rect.x;
+  m.y = box.rect.y;
+  m.width = box.rect.width;
+  m.height = box.rect.height;
+  return m;
+}
+
+detection::Box fromMsg(const BoundingBox& m) {
+  detection::Box b;
+  b.class_id = m.class_id;
+  b.label = m.label;
+  b.score = m.score;
+  b.rect = cv::Rect2f(m.x, m.y, m.width, m.height);
+  return b;
+}
+
+void toMsg(const detection::Boxes& boxes, BoundingBoxes& msg) {
+  msg.boxes.clear();
+  msg.boxes.reserve(boxes.size());
+  for (const auto& b : boxes) msg.boxes.push_back(toMsg(b));
+}
+
+detection::Boxes boxesFromMsg(const std::vector<BoundingBox>& msgs) {
+  detection::Boxes out;
+  out.reserve(msgs.size());
+  for (const auto& m : msgs) out.push_back(fromMsg(m));
+  return out;
+}
+
+void toMsg(const features::FeatureFrame& f, const detection::Boxes& boxes, KeypointFrame& msg) {
+  const size_t n = f.keypoints.size();
+  msg.width = static_cast<uint32_t>(f.width);
+  msg.height = static_cast<uint32_t>(f.height);
+  msg.keypoints.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const cv::KeyPoint& k = f.keypoints[i];
+    auto& m = msg.keypoints[i];
+    m.x = k.pt.x;
+    m.y = k.pt.y;
+    m.octave = k.octave;
+    m.angle = k.angle;
+    m.response = k.response;
+  }
+  msg.descriptors.resize(n * 32);
+  if (n > 0) {
+    if (f.descriptors.rows != static_cast<int>(n) || f.descriptors.cols != 32 ||
+        f.descriptors.type() != CV_8U)
+      throw Error("KeypointFrame: descriptors must be " + std::to_string(n) +
+                  " x 32 CV_8U, got " + std::to_string(f.descriptors.rows) + " x " +
+                  std::to_string(f.descriptors.cols));
+    for (size_t i = 0; i < n; ++i)
+      std::memcpy(&msg.descriptors[i * 32], f.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32);
+  }
+  msg.depth.assign(f.depth.begin(), f.depth.end());
+  msg.depth.resize(n, 0.f);
+  msg.dynamic.assign(f.dynamic.begin(), f.dynamic.end());
+  msg.dynamic.resize(n, 0);
+  msg.boxes.clear();
+  msg.boxes.reserve(boxes.size());
+  for (const auto& b : boxes) msg.boxes.push_back(toMsg(b));
+}
+
+features::FeatureFrame fromMsg(const KeypointFrame& msg, const CameraModel& cam) {
+  const size_t n = msg.keypoints.size();
+  if (msg.descriptors.size() != n * 32 || msg.depth.size() != n || msg.dynamic.size() != n)
+    throw Error("KeypointFrame: inconsistent arrays (" + std::to_string(n) + " keypoints, " +
+                std::to_string(msg.descriptors.size()) + " descriptor bytes, " +
+                std::to_string(msg.depth.size()) + " depths, " +
+                std::to_string(msg.dynamic.size()) +
+                " flags); expected N, 32*N, N, N. Publish frames with yolo_slam/Screening");
+  if (msg.width == 0 || msg.height == 0)
+    throw Error("KeypointFrame: width/height are 0; the image size is needed for tracking");
+  features::FeatureFrame f;
+  f.stamp = msg.header.stamp.toSec();
+  f.width = static_cast<int>(msg.width);
+  f.height = static_cast<int>(msg.height);
+  f.keypoints.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const auto& m = msg.keypoints[i];
+    cv::KeyPoint& k = f.keypoints[i];
+    k.pt = cv::Point2f(m.x, m.y);
+    k.octave = m.octave;
+    k.angle = m.angle;
+    k.response = m.response;
+    // ORB patch size at the keypoint's level, as the extractor sets it (31 * scale).
+    k.size = 31.f;
+  }
+  if (cam.hasDistortion() && n > 0) {
+    std::vector<cv::Point2f> pts(n);
+    for (size_t i = 0; i < n; ++i) pts[i] = f.keypoints[i].pt;
+    std::vector<cv::Point2f> un = cam.undistort(pts);
+    f.keypoints_un = f.keypoints;
+    for (size_t i = 0; i < n; ++i) f.keypoints_un[i].pt = un[i];
+  } else {
+    f.keypoints_un = f.keypoints;
+  }
+  f.descriptors = cv::Mat(static_cast<int>(n), 32, CV_8U);
+  if (n > 0) std::memcpy(f.descriptors.data, msg.descriptors.data(), n * 32);
+  f.depth.assign(msg.depth.begin(), msg.depth.end());
+  f.dynamic.assign(msg.dynamic.begin(), msg.dynamic.end());
+  f.right_u.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float d = f.depth[i];
+    f.right_u[i] = d > 0 ? static_cast<float>(f.keypoints_un[i].pt.x - cam.bf / d) : -1.f;
+  }
+  return f;
+}
+
+namespace {
+
+void checkImage(const sensor_msgs::Image& msg, const std::string& topic, int channels,
+                int bytes_per_channel) {
+  if (msg.width == 0 || msg.height == 0 || msg.data.empty())
+    throw Error("empty image on " + topic + " (" + std::to_string(msg.width) + "x" +
+                std::to_string(msg.height) + ", " + std::to_string(msg.data.size()) +
+                " bytes); check the camera driver or bag");
+  const size_t row = static_cast<size_t>(msg.width) * channels * bytes_per_channel;
+  if (msg.step < row || msg.data.size() < static_cast<size_t>(msg.step) * msg.height)
+    throw Error("image on " + topic + " has inconsistent step/data size (step " +
+                std::to_string(msg.step) + ", " + std::to_string(msg.data.size()) +
+                " bytes for " + std::to_string(msg.width) + "x" + std::to_string(msg.height) +
+                " " + msg.encoding + ")");
+}
+
+cv::Mat wrap(const sensor_msgs::Image& msg, int type) {
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
+                 const_cast<uint8_t*>(msg.data.data()), msg.step);
+}
+
+}  // namespace
+
+cv::Mat imageView(const sensor_msgs::Image& msg, const std::string& topic, bool& is_rgb) {
+  const std::string& e = msg.encoding;
+  if (e == enc::RGB8 || e == enc::BGR8) {
+    checkImage(msg, topic, 3, 1);
+    is_rgb = e == enc::RGB8;
+    return wrap(msg, CV_8UC3);
+  }
+  is_rgb = false;
+  return imageToBgr(msg, topic);
+}
+
+cv::Mat imageToBgr(const sensor_msgs::Image& msg, const std::string& topic) {
+  const std::string& e = msg.encoding;
+  cv::Mat out;
+  if (e == enc::RGB8 || e == enc::BGR8) {
+    checkImage(msg, topic, 3, 1);
+    if (e == enc::RGB8)
+      cv::cvtColor(wrap(msg, CV_8UC3), out, cv::COLOR_RGB2BGR);
+    else
+      out = wrap(msg, CV_8UC3).clone();
+  } else if (e == enc::RGBA8 || e == enc::BGRA8) {
+    checkImage(msg, topic, 4, 1);
+    cv::cvtColor(wrap(msg, CV_8UC4), out, e == enc::RGBA8 ? cv::COLOR_RGBA2BGR : cv::COLOR_BGRA2BGR);
+  } else if (e == enc::MONO8) {
+    checkImage(msg, topic, 1, 1);
+    cv::cvtColor(wrap(msg, CV_8UC1), out, cv::COLOR_GRAY2BGR);
+  } else {
+    throw Error("unsupported colour encoding '" + e + "' on " + topic +
+                "; expected rgb8, bgr8, rgba8, bgra8 or mono8 (is a depth topic remapped "
+                "to the colour input?)");
+  }
+  return out;
+}
+
+cv::Mat depthToMetres(const sensor_msgs::Image& msg, const std::string& topic, double factor_16u) {
+  const std::string& e = msg.encoding;
+  if (e == enc::TYPE_16UC1 || e == enc::MONO16) {
+    checkImage(msg, topic, 1, 2);
+    return io::decodeDepth(wrap(msg, CV_16UC1), factor_16u, topic);
+  }
+  if (e == enc::TYPE_32FC1) {
+    checkImage(msg, topic, 1, 4);
+    return io::decodeDepth(wrap(msg, CV_32FC1), 1.0, topic);
+  }
+  throw Error("unsupported depth encoding '" + e + "' on " + topic +
+              "; expected 16UC1 (millimetres) or 32FC1 (metres), see REP 118");
+}
+
+CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraModel& base,
+                           const std::string& topic) {
+  if (info.width == 0 || info.height == 0 || info.K[0] <= 0 || info.K[4] <= 0)
+    throw Error("camera_info on " + topic + " has no calibration (size " +
+                std::to_string(info.width) + "x" + std::to_string(info.height) + ", fx " +
+                std::to_string(info.K[0]) + "); calibrate the camera or set use_camera_info "
+                "false to use the settings file");
+  CameraModel cam = base;
+  // Keep bf as baseline * fx when fx changes, so ThDepth keeps its meaning in metres.
+  const double baseline = base.fx > 0 ? base.bf / base.fx : 0.0;
+  cam.fx = info.K[0];
+  cam.fy = info.K[4];
+  cam.cx = info.K[2];
+  cam.cy = info.K[5];
+  cam.bf = baseline * cam.fx;
+  cam.width = static_cast<int>(info.width);
+  cam.height = static_cast<int>(info.height);
+  cam.k1 = cam.k2 = cam.p1 = cam.p2 = cam.k3 = 0;
+  if (info.distortion_model == "plumb_bob" || info.distortion_model == "rational_polynomial") {
+    const auto& D = info.D;
+    if (D.size() > 0) cam.k1 = D[0];
+    if (D.size() > 1) cam.k2 = D[1];
+    if (D.size() > 2) cam.p1 = D[2];
+    if (D.size() > 3) cam.p2 = D[3];
+    if (D.size() > 4) cam.k3 = D[4];
+  }
+  return cam;
+}
+
+geometry_msgs::Pose poseToMsg(const Pose& T) {
+  geometry_msgs::Pose m;
+  const Eigen::Quaterniond q(T.linear());
+  m.position.x = T.translation().x();
+  m.position.y = T.translation().y();
+  m.position.z = T.translation().z();
+  m.orientation.x = q.x();
+  m.orientation.y = q.y();
+  m.orientation.z = q.z();
+  m.orientation.w = q.w();
+  return m;
+}
+
+Pose poseFromMsg(const geometry_msgs::Pose& m) {
+  return makePose(Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y,
+                                     m.orientation.z),
+                  Eigen::Vector3d(m.position.x, m.position.y, m.position.z));
+}
+
+geometry_msgs::Transform transformToMsg(const Pose& T) {
+  geometry_msgs::Transform m;
+  const Eigen::Quaterniond q(T.linear());
+  m.translation.x = T.translation().x();
+  m.translation.y = T.translation().y();
+  m.translation.z = T.translation().z();
+  m.rotation.x = q.x();
+  m.rotation.y = q.y();
+  m.rotation.z = q.z();
+  m.rotation.w = q.w();
+  return m;
+}
+
+Pose transformFromMsg(const geometry_msgs::Transform& m) {
+  return makePose(Eigen::Quaterniond(m.rotation.w, m.rotation.x, m.rotation.y, m.rotation.z),
+                  Eigen::Vector3d(m.translation.x, m.translation.y, m.translation.z));
+}
+
+}  // namespace ros1
+}  // namespace yolo_slam

@@ -1,0 +1,562 @@
+// yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Outputs follow REP 103 /
+// REP 105: tf map -> odom -> base_link (or map -> camera when asked), the base pose, its path,
+// the static map points, keyframes with covisibility edges and a debug image; services reset,
+// save_trajectory (TUM format) and set_localization_mode.
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Path.h>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+#include <opencv2/imgproc.hpp>
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "nodelet_common.h"
+#include "yolo_slam/KeypointFrame.h"
+#include "yolo_slam/SaveTrajectory.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/timing.h"
+#include "yolo_slam/detection/draw.h"
+#include "yolo_slam/io/trajectory.h"
+#include "yolo_slam/ros/conversions.h"
+#include "yolo_slam/slam/system.h"
+#include "yolo_slam/vocabulary/vocabulary.h"
+
+namespace yolo_slam {
+namespace ros1 {
+
+namespace {
+
+const char* stateName(slam::TrackingState s) {
+  switch (s) {
+    case slam::TrackingState::NotInitialized: return "not initialised";
+    case slam::TrackingState::Ok: return "ok";
+    case slam::TrackingState::Lost: return "lost";
+  }
+  return "?";
+}
+
+// [x y z qx qy qz qw] -> Pose; throws Error naming the parameter.
+Pose poseFromParam(const std::vector<double>& v, const std::string& name) {
+  if (v.size() != 7)
+    throw Error("parameter " + name + " needs 7 numbers [x, y, z, qx, qy, qz, qw], got " +
+                std::to_string(v.size()));
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (q.norm() < 1e-9) throw Error("parameter " + name + " has a zero quaternion");
+  return makePose(q, Eigen::Vector3d(v[0], v[1], v[2]));
+}
+
+}  // namespace
+
+class SlamNodelet : public nodelet::Nodelet {
+ public:
+  ~SlamNodelet() override {
+    map_timer_.stop();
+    diag_timer_.stop();
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    if (!system_) return;
+    if (!trajectory_path_.empty()) {
+      try {
+        const Trajectory traj = system_->cameraTrajectory();
+        io::writeTrajectory(trajectory_path_, traj);
+        ROS_INFO("Slam: wrote %zu poses to %s at shutdown", traj.size(), trajectory_path_.c_str());
+      } catch (const std::exception& e) {
+        ROS_ERROR("Slam: cannot write the trajectory at shutdown: %s", e.what());
+      }
+    }
+    system_->shutdown();
+  }
+
+ private:
+  void onInit() override {
+    ::ros::NodeHandle& nh = getNodeHandle();
+    ::ros::NodeHandle& pnh = getPrivateNodeHandle();
+    int queue_size = 100;
+    pnh.param("queue_size", queue_size, 100);
+    pnh.param("use_camera_info", use_camera_info_, true);
+    pnh.param("camera_info_wait", camera_info_wait_, 1.0);
+    pnh.param<std::string>("map_frame", map_frame_, "map");
+    pnh.param<std::string>("odom_frame", odom_frame_, "odom");
+    pnh.param<std::string>("base_frame", base_frame_, "base_link");
+    pnh.param<std::string>("camera_frame", camera_frame_, "");
+    pnh.param("publish_tf", publish_tf_, true);
+    pnh.param("publish_odom_tf", publish_odom_tf_, true);
+    pnh.param("publish_map_to_camera", map_to_camera_, false);
+    pnh.param<std::string>("trajectory_path", trajectory_path_, "");
+    pnh.param("map_publish_period", map_period_, 1.0);
+    pnh.param("debug_image", debug_image_, true);
+    std::vector<double> b2c{0, 0, 0, -0.5, 0.5, -0.5, 0.5};
+    pnh.param("base_to_camera", b2c, b2c);
+    std::string settings_path, voc_path;
+    pnh.param<std::string>("vocabulary", voc_path, "");
+    try {
+      T_bc_ = poseFromParam(b2c, pnh.resolveName("base_to_camera"));
+      settings_ = loadSettings(pnh, &settings_path);
+      base_cam_ = baseCamera(settings_);
+      if (!voc_path.empty()) {
+        Stopwatch sw;
+        vocabulary_ = vocabulary::Vocabulary::load(voc_path);
+        NODELET_INFO("Slam: vocabulary %s (%zu words) loaded in %.1f s", voc_path.c_str(),
+                     vocabulary_->size(), sw.ms() / 1000.0);
+      } else {
+        NODELET_WARN("Slam: no ~vocabulary: relocalisation and loop closing are off");
+      }
+    } catch (const std::exception& e) {
+      NODELET_ERROR("Slam: %s. The nodelet is idle until restarted with valid parameters",
+                    e.what());
+      return;
+    }
+
+    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("yolo_slam/pose", 10);
+    path_pub_ = nh.advertise<nav_msgs::Path>("yolo_slam/path", 1, true);
+    cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("yolo_slam/map_points", 1, true);
+    marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
+    debug_pub_ = nh.advertise<sensor_msgs::Image>("yolo_slam/debug_image", 2);
+    diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+    info_sub_ = nh.subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
+    if (debug_image_)
+      rgb_sub_ = nh.subscribe("camera/rgb/image_color", 30, &SlamNodelet::onRgb, this);
+    frame_sub_ = nh.subscribe("yolo_slam/keypoint_frame", queue_size, &SlamNodelet::onFrame, this,
+                              ::ros::TransportHints().tcpNoDelay());
+    reset_srv_ = nh.advertiseService("yolo_slam/reset", &SlamNodelet::onReset, this);
+    save_srv_ = nh.advertiseService("yolo_slam/save_trajectory", &SlamNodelet::onSave, this);
+    loc_srv_ = nh.advertiseService("yolo_slam/set_localization_mode", &SlamNodelet::onLocalization,
+                                   this);
+    if (!publish_odom_tf_ && publish_tf_ && !map_to_camera_) {
+      tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+      tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+    }
+    if (map_period_ > 0)
+      map_timer_ = nh.createWallTimer(::ros::WallDuration(map_period_),
+                                      [this](const ::ros::WallTimerEvent&) { publishMap(); });
+    diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
+                                     [this](const ::ros::WallTimerEvent&) { publishDiagnostics(); });
+    NODELET_INFO("Slam: tf %s, settings '%s'",
+                 !publish_tf_ ? "off"
+                 : map_to_camera_ ? (map_frame_ + " -> camera").c_str()
+                 : publish_odom_tf_ ? (map_frame_ + " -> " + odom_frame_ + " -> " + base_frame_).c_str()
+                                    : (map_frame_ + " -> " + odom_frame_ + " (odometry from tf)").c_str(),
+                 settings_path.c_str());
+  }
+
+  void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
+    try {
+      CameraModel cam = cameraFromInfo(*info, base_cam_, info_sub_.getTopic());
+      std::lock_guard<std::mutex> lock(cam_mutex_);
+      cam_ = cam;
+      cam_cv_.notify_all();
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(5.0, "Slam: %s", e.what());
+    }
+  }
+
+  void onRgb(const sensor_msgs::ImageConstPtr& img) {
+    std::lock_guard<std::mutex> lock(rgb_mutex_);
+    recent_rgb_.push_back(img);
+    while (recent_rgb_.size() > 60) recent_rgb_.pop_front();
+  }
+
+  CameraModel camera() {
+    if (!use_camera_info_) return base_cam_;
+    std::unique_lock<std::mutex> lock(cam_mutex_);
+    cam_cv_.wait_for(lock, std::chrono::duration<double>(camera_info_wait_),
+                     [this] { return cam_.has_value(); });
+    if (!cam_)
+      throw Error("no camera_info received on " + info_sub_.getTopic() +
+                  "; publish the camera's CameraInfo or set ~use_camera_info false to take "
+                  "the intrinsics from ~settings");
+    return *cam_;
+  }
+
+  void onFrame(const KeypointFrame::ConstPtr& msg) {
+    if (last_index_ != 0 && msg->index > last_index_ + 1) {
+      const size_t gap = msg->index - last_index_ - 1;
+      dropped_ += gap;
+      NODELET_WARN("Slam: %zu keypoint frame(s) dropped before %.3f (%zu in total); raise "
+                   "~queue_size or play the bag slower", gap, msg->header.stamp.toSec(),
+                   dropped_.load());
+    }
+    last_index_ = msg->index;
+    ++received_;
+    slam::TrackResult res;
+    features::FeatureFrame frame;
+    try {
+      const CameraModel cam = camera();
+      frame = fromMsg(*msg, cam);
+      if (frame.width != cam.width || frame.height != cam.height)
+        throw Error("keypoint frame is " + std::to_string(frame.width) + "x" +
+                    std::to_string(frame.height) + " but the calibration is " +
+                    std::to_string(cam.width) + "x" + std::to_string(cam.height));
+      Stopwatch sw;
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      if (!system_) {
+        system_ = std::make_unique<slam::System>(cam, settings_, vocabulary_);
+        NODELET_INFO("Slam: started (fx %.1f fy %.1f cx %.1f cy %.1f, %dx%d)", cam.fx, cam.fy,
+                     cam.cx, cam.cy, cam.width, cam.height);
+      }
+      res = system_->trackFeatures(frame);
+      track_ms_.push_back(sw.ms());
+      if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
+    } catch (const std::exception& e) {
+      ++rejected_;
+      NODELET_ERROR_THROTTLE(1.0, "Slam: frame %.3f rejected: %s", msg->header.stamp.toSec(),
+                             e.what());
+      return;
+    }
+    last_state_ = res.state;
+    if (res.state == slam::TrackingState::Ok) {
+      ++tracked_;
+      publishPose(*msg, res.T_wc);
+    } else {
+      ++not_tracked_;
+      NODELET_WARN_THROTTLE(2.0, "Slam: tracking %s at %.3f (%d inliers)", stateName(res.state),
+                            msg->header.stamp.toSec(), res.inliers);
+    }
+    if (debug_image_ && debug_pub_.getNumSubscribers() > 0) publishDebug(*msg, res);
+  }
+
+  // Camera pose in the SLAM world (first camera frame) -> base_link pose in the map frame
+  // (the first base_link frame, so the map is z-up when base_to_camera is right).
+  Pose mapFromWorld(const Pose& T_wc) const { return T_bc_ * T_wc * T_bc_.inverse(); }
+
+  void publishPose(const KeypointFrame& msg, const Pose& T_wc) {
+    const ::ros::Time stamp = msg.header.stamp;
+    const std::string camera_frame = camera_frame_.empty() ? msg.header.frame_id : camera_frame_;
+    // Pose of the published child frame in the map frame.
+    const Pose T_map_base = mapFromWorld(T_wc);
+    const Pose T_map_cam = T_bc_ * T_wc;
+    geometry_msgs::PoseStamped ps;
+    ps.header.stamp = stamp;
+    ps.header.frame_id = map_frame_;
+    ps.pose = poseToMsg(map_to_camera_ ? T_map_cam : T_map_base);
+    pose_pub_.publish(ps);
+    {
+      std::lock_guard<std::mutex> lock(path_mutex_);
+      path_.header = ps.header;
+      path_.poses.push_back(ps);
+      path_pub_.publish(path_);
+    }
+    if (!publish_tf_) return;
+    std::vector<geometry_msgs::TransformStamped> tfs;
+    auto add = [&](const std::string& parent, const std::string& child, const Pose& T) {
+      geometry_msgs::TransformStamped t;
+      t.header.stamp = stamp;
+      t.header.frame_id = parent;
+      t.child_frame_id = child;
+      t.transform = transformToMsg(T);
+      tfs.push_back(t);
+    };
+    if (map_to_camera_) {
+      add(map_frame_, camera_frame, T_map_cam);
+    } else if (publish_odom_tf_) {
+      // Visual odometry is the only motion source: odom follows the SLAM pose, map -> odom
+      // stays identity (loop closures show up as jumps of odom -> base_link).
+      add(map_frame_, odom_frame_, Pose::Identity());
+      add(odom_frame_, base_frame_, T_map_base);
+      add(base_frame_, camera_frame, T_bc_);
+    } else {
+      // Wheel/IMU odometry publishes odom -> base_link; we correct its drift with map -> odom.
+      try {
+        const auto t = tf_buffer_->lookupTransform(odom_frame_, base_frame_, stamp,
+                                                   ::ros::Duration(0.1));
+        const Pose T_odom_base = transformFromMsg(t.transform);
+        add(map_frame_, odom_frame_, T_map_base * T_odom_base.inverse());
+      } catch (const std::exception& e) {
+        NODELET_ERROR_THROTTLE(2.0, "Slam: no %s -> %s transform at %.3f (%s); map -> odom not "
+                               "published. Set ~publish_odom_tf true if nothing else publishes "
+                               "odometry", odom_frame_.c_str(), base_frame_.c_str(),
+                               stamp.toSec(), e.what());
+      }
+    }
+    if (!tfs.empty()) tf_broadcaster_.sendTransform(tfs);
+  }
+
+  void publishDebug(const KeypointFrame& msg, const slam::TrackResult& res) {
+    sensor_msgs::ImageConstPtr rgb;
+    {
+      std::lock_guard<std::mutex> lock(rgb_mutex_);
+      for (auto it = recent_rgb_.rbegin(); it != recent_rgb_.rend(); ++it)
+        if ((*it)->header.stamp == msg.header.stamp) {
+          rgb = *it;
+          break;
+        }
+    }
+    cv::Mat img;
+    try {
+      if (rgb) img = imageToBgr(*rgb, rgb_sub_.getTopic());
+    } catch (const std::exception&) {
+      // The colour image was already reported by the Screening nodelet; draw on grey instead.
+    }
+    if (img.empty()) img = cv::Mat(msg.height, msg.width, CV_8UC3, cv::Scalar(64, 64, 64));
+    detection::drawBoxes(img, boxesFromMsg(msg.boxes));
+    int kept = 0, dropped = 0;
+    for (size_t i = 0; i < msg.keypoints.size(); ++i) {
+      const bool dyn = msg.dynamic[i] != 0;
+      (dyn ? dropped : kept)++;
+      const cv::Point p(cvRound(msg.keypoints[i].x), cvRound(msg.keypoints[i].y));
+      if (dyn)
+        cv::drawMarker(img, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 7, 1);
+      else
+        cv::circle(img, p, 3, cv::Scalar(0, 255, 0), 1);
+    }
+    const std::string text = std::string("tracking ") + stateName(res.state) + "  kept " +
+                             std::to_string(kept) + "  dropped " + std::to_string(dropped) +
+                             "  inliers " + std::to_string(res.inliers);
+    cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3);
+    cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                cv::Scalar(255, 255, 255), 1);
+    auto out = boost::make_shared<sensor_msgs::Image>();
+    out->header = msg.header;
+    out->width = img.cols;
+    out->height = img.rows;
+    out->encoding = sensor_msgs::image_encodings::BGR8;
+    out->step = img.cols * 3;
+    out->data.assign(img.data, img.data + img.total() * 3);
+    debug_pub_.publish(out);
+  }
+
+  void publishMap() {
+    slam::MapSnapshot snap;
+    Trajectory traj;
+    {
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      if (!system_) return;
+      snap = system_->mapSnapshot();
+      traj = system_->cameraTrajectory();
+    }
+    const ::ros::Time now = ::ros::Time::now();
+    // Path rebuilt from the optimised trajectory (local BA and loop closing move old poses).
+    if (!traj.empty()) {
+      std::lock_guard<std::mutex> lock(path_mutex_);
+      path_.header.frame_id = map_frame_;
+      path_.header.stamp = ::ros::Time(traj.back().stamp);
+      path_.poses.clear();
+      path_.poses.reserve(traj.size());
+      for (const auto& sp : traj) {
+        geometry_msgs::PoseStamped ps;
+        ps.header.frame_id = map_frame_;
+        ps.header.stamp = ::ros::Time(sp.stamp);
+        ps.pose = poseToMsg(map_to_camera_ ? T_bc_ * sp.T_wc : mapFromWorld(sp.T_wc));
+        path_.poses.push_back(ps);
+      }
+      path_pub_.publish(path_);
+    }
+
+    auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
+    cloud->header.frame_id = map_frame_;
+    cloud->header.stamp = now;
+    sensor_msgs::PointCloud2Modifier mod(*cloud);
+    mod.setPointCloud2FieldsByString(1, "xyz");
+    mod.resize(snap.points.size());
+    sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+    for (const auto& p : snap.points) {
+      const Eigen::Vector3d q = T_bc_ * p;
+      *x = static_cast<float>(q.x());
+      *y = static_cast<float>(q.y());
+      *z = static_cast<float>(q.z());
+      ++x, ++y, ++z;
+    }
+    cloud_pub_.publish(cloud);
+
+    auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
+    visualization_msgs::Marker kf, edges;
+    kf.header.frame_id = edges.header.frame_id = map_frame_;
+    kf.header.stamp = edges.header.stamp = now;
+    kf.ns = "keyframes";
+    edges.ns = "covisibility";
+    kf.type = edges.type = visualization_msgs::Marker::LINE_LIST;
+    kf.action = edges.action = visualization_msgs::Marker::ADD;
+    kf.pose.orientation.w = edges.pose.orientation.w = 1.0;
+    kf.scale.x = 0.005;
+    edges.scale.x = 0.002;
+    kf.color.b = 1.0f;
+    kf.color.a = 1.0f;
+    edges.color.g = 0.8f;
+    edges.color.a = 0.6f;
+    auto pt = [](const Eigen::Vector3d& v) {
+      geometry_msgs::Point p;
+      p.x = v.x();
+      p.y = v.y();
+      p.z = v.z();
+      return p;
+    };
+    // A small camera frustum per keyframe (apex + 4 image corners at 5 cm).
+    const double w = 0.04, h = 0.03, d = 0.05;
+    const Eigen::Vector3d corners[4] = {{-w, -h, d}, {w, -h, d}, {w, h, d}, {-w, h, d}};
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& k : snap.keyframes) {
+      const Pose T = T_bc_ * k.T_wc;
+      const Eigen::Vector3d o = T.translation();
+      centres.push_back(o);
+      for (int i = 0; i < 4; ++i) {
+        kf.points.push_back(pt(o));
+        kf.points.push_back(pt(T * corners[i]));
+        kf.points.push_back(pt(T * corners[i]));
+        kf.points.push_back(pt(T * corners[(i + 1) % 4]));
+      }
+    }
+    for (const auto& e : snap.covisibility_edges) {
+      if (e.first < 0 || e.second < 0 || e.first >= static_cast<int>(centres.size()) ||
+          e.second >= static_cast<int>(centres.size()))
+        continue;
+      edges.points.push_back(pt(centres[e.first]));
+      edges.points.push_back(pt(centres[e.second]));
+    }
+    if (kf.points.empty()) kf.action = visualization_msgs::Marker::DELETE;
+    if (edges.points.empty()) edges.action = visualization_msgs::Marker::DELETE;
+    markers->markers.push_back(kf);
+    markers->markers.push_back(edges);
+    marker_pub_.publish(markers);
+  }
+
+  void publishDiagnostics() {
+    diagnostic_msgs::DiagnosticStatus st;
+    st.name = getName() + ": tracking";
+    st.hardware_id = "yolo_slam";
+    Summary s;
+    {
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      s = summarize(track_ms_);
+    }
+    const size_t dropped = dropped_, rejected = rejected_;
+    const slam::TrackingState state = last_state_;
+    st.level = dropped + rejected > 0 || state == slam::TrackingState::Lost
+                   ? diagnostic_msgs::DiagnosticStatus::WARN
+                   : diagnostic_msgs::DiagnosticStatus::OK;
+    st.message = std::string("tracking ") + stateName(state) + ", " + std::to_string(dropped) +
+                 " dropped, " + std::to_string(rejected) + " rejected";
+    auto kv = [&](const std::string& k, size_t v) {
+      diagnostic_msgs::KeyValue p;
+      p.key = k;
+      p.value = std::to_string(v);
+      st.values.push_back(p);
+    };
+    kv("received", received_);
+    kv("tracked", tracked_);
+    kv("not_tracked", not_tracked_);
+    kv("dropped", dropped);
+    kv("rejected_bad_input", rejected);
+    diagnostic_msgs::KeyValue m;
+    m.key = "track_median_ms";
+    m.value = std::to_string(s.median);
+    st.values.push_back(m);
+    diagnostic_msgs::DiagnosticArray arr;
+    arr.header.stamp = ::ros::Time::now();
+    arr.status.push_back(st);
+    diag_pub_.publish(arr);
+  }
+
+  bool onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+    {
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      if (system_) system_->reset();
+    }
+    {
+      std::lock_guard<std::mutex> lock(path_mutex_);
+      path_.poses.clear();
+    }
+    res.success = true;
+    res.message = "map and trajectory cleared";
+    NODELET_INFO("Slam: reset by service");
+    return true;
+  }
+
+  bool onSave(SaveTrajectory::Request& req, SaveTrajectory::Response& res) {
+    const std::string path = req.path.empty() ? trajectory_path_ : req.path;
+    if (path.empty()) {
+      res.success = false;
+      res.message = "no path given and ~trajectory_path is empty";
+      return true;
+    }
+    try {
+      Trajectory traj;
+      {
+        std::lock_guard<std::mutex> lock(system_mutex_);
+        if (system_) traj = system_->cameraTrajectory();
+      }
+      io::writeTrajectory(path, traj);
+      res.success = true;
+      res.poses = static_cast<uint32_t>(traj.size());
+      res.message = path;
+      NODELET_INFO("Slam: wrote %zu poses to %s", traj.size(), path.c_str());
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      NODELET_ERROR("Slam: save_trajectory failed: %s", e.what());
+    }
+    return true;
+  }
+
+  bool onLocalization(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    localization_only_ = req.data;
+    if (system_) system_->setLocalizationOnly(req.data);
+    res.success = true;
+    res.message = req.data ? "localization only: mapping paused" : "mapping resumed";
+    NODELET_INFO("Slam: %s", res.message.c_str());
+    return true;
+  }
+
+  // Parameters (const after onInit).
+  bool use_camera_info_ = true, publish_tf_ = true, publish_odom_tf_ = true;
+  bool map_to_camera_ = false, debug_image_ = true;
+  double camera_info_wait_ = 1.0, map_period_ = 1.0;
+  std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_;
+  Pose T_bc_ = Pose::Identity();  // camera pose in base_link
+  Config settings_;
+  CameraModel base_cam_;
+  std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
+
+  std::mutex cam_mutex_;  // guards cam_ (camera_info callback vs frame callback)
+  std::condition_variable cam_cv_;
+  std::optional<CameraModel> cam_;
+
+  // Guards system_, localization_only_ and track_ms_ (frame callback, map timer, services,
+  // diagnostics). Lock order: system_mutex_ before path_mutex_ (never the reverse).
+  std::mutex system_mutex_;
+  std::unique_ptr<slam::System> system_;
+  bool localization_only_ = false;
+  std::vector<double> track_ms_;
+
+  std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
+  nav_msgs::Path path_;
+
+  std::mutex rgb_mutex_;  // guards recent_rgb_ (colour callback vs frame callback)
+  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_;
+
+  // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
+  uint32_t last_index_ = 0;
+  std::atomic<size_t> received_{0}, tracked_{0}, not_tracked_{0}, dropped_{0}, rejected_{0};
+  std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
+
+  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;
+  ::ros::Publisher pose_pub_, path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
+  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_;
+  ::ros::WallTimer map_timer_, diag_timer_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+};
+
+}  // namespace ros1
+}  // namespace yolo_slam
+
+PLUGINLIB_EXPORT_CLASS(yolo_slam::ros1::SlamNodelet, nodelet::Nodelet)
