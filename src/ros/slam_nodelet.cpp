@@ -239,7 +239,10 @@ class SlamNodelet : public nodelet::Nodelet {
 
   void publishPose(const KeypointFrame& msg, const Pose& T_wc) {
     const ::ros::Time stamp = msg.header.stamp;
-    const std::string camera_frame = camera_frame_.empty() ? msg.header.frame_id : camera_frame_;
+    std::string camera_frame = camera_frame_.empty() ? msg.header.frame_id : camera_frame_;
+    // TUM bags name frames "/openni_rgb_optical_frame"; tf2 frame ids may not start with '/'.
+    while (!camera_frame.empty() && camera_frame.front() == '/') camera_frame.erase(0, 1);
+    if (camera_frame.empty()) camera_frame = "camera_rgb_optical_frame";
     // Pose of the published child frame in the map frame.
     const Pose T_map_base = mapFromWorld(T_wc);
     const Pose T_map_cam = T_bc_ * T_wc;

@@ -1,0 +1,245 @@
+// The full graph on a bag converted from a short synthetic walking sequence (generated at test
+// time with yolo_slam_synth and scripts/tum_to_bag.py), played with rosbag at rate 1:
+// pose and path published, the tf tree map -> odom -> base_link -> camera complete, no frame
+// dropped, the trajectory saved by the service within an ATE bound. Optionally rviz runs under
+// Xvfb with config/yolo_slam.rviz and a screenshot must show the path and the map points.
+#include <gtest/gtest.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <unistd.h>
+
+#include "yolo_slam/SaveTrajectory.h"
+#include "yolo_slam/eval/ate.h"
+#include "yolo_slam/io/trajectory.h"
+
+namespace {
+
+std::mutex g_mutex;  // guards everything below (subscriber threads vs test thread)
+std::vector<double> g_pose_wall;  // wall time of each pose message
+size_t g_path_len = 0, g_cloud_points = 0, g_markers = 0, g_debug_images = 0;
+std::map<std::string, std::map<std::string, std::string>> g_diag;  // status name -> key -> value
+
+int run(const std::string& cmd) {
+  std::printf("[full_graph] $ %s\n", cmd.c_str());
+  std::fflush(stdout);
+  const int rc = std::system(cmd.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+bool waitFile(const std::string& path, double timeout_s) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
+  while (ros::WallTime::now() < end) {
+    if (access(path.c_str(), F_OK) == 0) return true;
+    ros::WallDuration(0.1).sleep();
+  }
+  return access(path.c_str(), F_OK) == 0;
+}
+
+long diagValue(const std::string& name_part, const std::string& key) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (const auto& s : g_diag)
+    if (s.first.find(name_part) != std::string::npos) {
+      auto it = s.second.find(key);
+      if (it != s.second.end()) return std::atol(it->second.c_str());
+    }
+  return -1;
+}
+
+// Pixels within `tol` of colour (r, g, b).
+int countColour(const cv::Mat& bgr, int r, int g, int b, int tol) {
+  int n = 0;
+  for (int y = 0; y < bgr.rows; ++y)
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+      if (std::abs(p[2] - r) <= tol && std::abs(p[1] - g) <= tol && std::abs(p[0] - b) <= tol) ++n;
+    }
+  return n;
+}
+
+TEST(FullGraph, SyntheticWalkingBag) {
+  ros::NodeHandle nh, pnh("~");
+  int frames = 60;
+  double ate_bound = 0.05;
+  bool rviz = false;
+  std::string preset, script, rviz_config, screenshot;
+  pnh.param("frames", frames, 60);
+  pnh.param("ate_bound", ate_bound, 0.05);
+  pnh.param("rviz", rviz, false);
+  pnh.param<std::string>("preset", preset, "walking_xyz");
+  pnh.param<std::string>("tum_to_bag", script, "");
+  pnh.param<std::string>("rviz_config", rviz_config, "");
+  pnh.param<std::string>("screenshot", screenshot, "/tmp/yolo_slam_rviz.png");
+  ASSERT_FALSE(script.empty()) << "~tum_to_bag not set";
+
+  char tmpl[] = "/tmp/yolo_slam_full_graph_XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl, seq = dir + "/seq", bag = dir + "/seq.bag";
+  ASSERT_EQ(run("rosrun yolo_slam yolo_slam_synth --preset " + preset + " --seed 1 --frames " +
+                std::to_string(frames) + " --out " + seq + " > " + dir + "/synth.log 2>&1"), 0);
+  ASSERT_EQ(run("/usr/bin/python3 " + script + " " + seq + " " + bag + " > " + dir + "/bag.log 2>&1"), 0);
+
+  ros::Subscriber pose_sub = nh.subscribe<geometry_msgs::PoseStamped>(
+      "/yolo_slam/pose", 1000, [](const geometry_msgs::PoseStamped::ConstPtr&) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_pose_wall.push_back(ros::WallTime::now().toSec());
+      });
+  ros::Subscriber path_sub = nh.subscribe<nav_msgs::Path>(
+      "/yolo_slam/path", 10, [](const nav_msgs::Path::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_path_len = m->poses.size();
+      });
+  ros::Subscriber cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/yolo_slam/map_points", 10, [](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_cloud_points = static_cast<size_t>(m->width) * m->height;
+      });
+  ros::Subscriber marker_sub = nh.subscribe<visualization_msgs::MarkerArray>(
+      "/yolo_slam/keyframes", 10, [](const visualization_msgs::MarkerArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_markers = m->markers.empty() ? 0 : m->markers[0].points.size() / 16;
+      });
+  ros::Subscriber debug_sub = nh.subscribe<sensor_msgs::Image>(
+      "/yolo_slam/debug_image", 10, [](const sensor_msgs::Image::ConstPtr&) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        ++g_debug_images;
+      });
+  ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        for (const auto& s : m->status)
+          for (const auto& kv : s.values) g_diag[s.name][kv.key] = kv.value;
+      });
+  tf2_ros::Buffer tf_buffer(ros::Duration(600));
+  tf2_ros::TransformListener tf_listener(tf_buffer);
+
+  std::thread rviz_thread;
+  if (rviz) {
+    // rviz under Xvfb; the screenshot is taken when the test creates the file 'shoot'.
+    const std::string cmd =
+        "xvfb-run -a -s '-screen 0 1280x800x24' sh -c 'rviz -d " + rviz_config + " > " + dir +
+        "/rviz.log 2>&1 & R=$!; while [ ! -e " + dir + "/shoot ]; do sleep 0.2; done; import -window root " +
+        dir + "/shot.png; touch " + dir + "/shot_done; kill $R; wait $R' > " + dir + "/xvfb.log 2>&1";
+    rviz_thread = std::thread([cmd] { run(cmd); });
+    ros::WallDuration(8.0).sleep();  // rviz start-up under software OpenGL
+  }
+
+  // Wait for the graph to subscribe, then play at rate 1 (the ground-truth tf moved aside).
+  ros::Publisher probe = nh.advertise<sensor_msgs::Image>("/camera/rgb/image_color", 1);
+  const ros::WallTime ready_end = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::WallTime::now() < ready_end && probe.getNumSubscribers() < 3) ros::WallDuration(0.1).sleep();
+  ASSERT_GE(probe.getNumSubscribers(), 3u) << "Detector, Screening and Slam should subscribe the colour images";
+  probe.shutdown();
+  const ros::WallTime play_start = ros::WallTime::now();
+  ASSERT_EQ(run("rosbag play --quiet --rate 1 --delay 1 " + bag + " /tf:=/tf_groundtruth"), 0);
+  const double play_s = (ros::WallTime::now() - play_start).toSec();
+
+  // Let the graph drain: the Slam nodelet has tracked everything the Screening published.
+  const ros::WallTime drain_end = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::WallTime::now() < drain_end) {
+    const long pub = diagValue("screening", "published"), rec = diagValue("slam", "received");
+    if (pub > 0 && rec == pub) break;
+    ros::WallDuration(0.2).sleep();
+  }
+  ros::WallDuration(2.5).sleep();  // one more map publication and diagnostics round
+
+  const long screened = diagValue("screening", "published");
+  const long received = diagValue("slam", "received");
+  const long tracked = diagValue("slam", "tracked");
+  std::printf("[full_graph] bag %d frames played in %.1f s; screening published %ld, dropped by "
+              "sync %ld, rejected %ld; slam received %ld, tracked %ld, dropped %ld\n",
+              frames, play_s, screened, diagValue("screening", "dropped_by_sync"),
+              diagValue("screening", "rejected_bad_input"), received, tracked,
+              diagValue("slam", "dropped"));
+  // Every frame but the last (held by the approximate-time synchroniser until a newer one
+  // arrives) goes through; nothing is dropped or rejected.
+  EXPECT_GE(screened, frames - 2);
+  EXPECT_EQ(diagValue("screening", "dropped_by_sync"), 0);
+  EXPECT_EQ(diagValue("screening", "rejected_bad_input"), 0);
+  EXPECT_EQ(received, screened);
+  EXPECT_EQ(diagValue("slam", "dropped"), 0);
+  EXPECT_GE(tracked, (frames * 9) / 10 - 2);
+
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    EXPECT_GE(static_cast<long>(g_pose_wall.size()), tracked);
+    EXPECT_GE(static_cast<long>(g_path_len), tracked - 1);
+    EXPECT_GT(g_cloud_points, 100u);
+    EXPECT_GE(g_markers, 1u);
+    if (rviz) EXPECT_GT(g_debug_images, 0u);
+    if (g_pose_wall.size() > 1)
+      std::printf("[full_graph] output rate %.1f poses/s (%zu poses over %.2f s wall)\n",
+                  (g_pose_wall.size() - 1) / (g_pose_wall.back() - g_pose_wall.front()),
+                  g_pose_wall.size(), g_pose_wall.back() - g_pose_wall.front());
+    std::printf("[full_graph] path %zu poses, map %zu points, %zu keyframes\n", g_path_len,
+                g_cloud_points, g_markers);
+  }
+
+  // The tf tree map -> odom -> base_link -> camera optical frame.
+  std::string err;
+  EXPECT_TRUE(tf_buffer.canTransform("map", "odom", ros::Time(0), &err)) << err;
+  EXPECT_TRUE(tf_buffer.canTransform("odom", "base_link", ros::Time(0), &err)) << err;
+  EXPECT_TRUE(tf_buffer.canTransform("map", "openni_rgb_optical_frame", ros::Time(0), &err)) << err;
+  std::string parent;
+  EXPECT_TRUE(tf_buffer._getParent("openni_rgb_optical_frame", ros::Time(0), parent));
+  EXPECT_EQ(parent, "base_link");
+  EXPECT_TRUE(tf_buffer._getParent("base_link", ros::Time(0), parent));
+  EXPECT_EQ(parent, "odom");
+
+  // Trajectory through the service, evaluated against the ground truth.
+  yolo_slam::SaveTrajectory srv;
+  srv.request.path = dir + "/trajectory.txt";
+  ASSERT_TRUE(ros::service::waitForService("/yolo_slam/save_trajectory", 5000));
+  ASSERT_TRUE(ros::service::call("/yolo_slam/save_trajectory", srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(static_cast<long>(srv.response.poses), tracked);
+  const auto est = yolo_slam::io::readTrajectory(srv.request.path);
+  const auto gt = yolo_slam::io::readTrajectory(seq + "/groundtruth.txt");
+  const auto ate = yolo_slam::eval::computeAte(gt, est);
+  std::printf("[full_graph] ATE rmse %.4f m over %zu pairs (bound %.3f); trajectory %s\n",
+              ate.stats.rmse, ate.stats.count, ate_bound, srv.request.path.c_str());
+  EXPECT_LT(ate.stats.rmse, ate_bound);
+  EXPECT_GE(static_cast<long>(ate.stats.count), tracked - 2);
+
+  if (rviz) {
+    std::ofstream(dir + "/shoot").put('\n');
+    const bool shot = waitFile(dir + "/shot_done", 30.0);
+    rviz_thread.join();
+    ASSERT_TRUE(shot) << "no screenshot; see " << dir << "/xvfb.log and rviz.log";
+    const cv::Mat img = cv::imread(dir + "/shot.png", cv::IMREAD_COLOR);
+    ASSERT_FALSE(img.empty()) << dir << "/shot.png";
+    cv::imwrite(screenshot, img);
+    // The path is magenta (255, 0, 255) and the map points cyan (0, 255, 255) in the config.
+    const int path_px = countColour(img, 255, 0, 255, 40);
+    const int cloud_px = countColour(img, 0, 255, 255, 40);
+    std::printf("[full_graph] screenshot %s: %d path pixels, %d map point pixels\n",
+                screenshot.c_str(), path_px, cloud_px);
+    EXPECT_GT(path_px, 50);
+    EXPECT_GT(cloud_px, 100);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_ros_full_graph");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
