@@ -1,0 +1,93 @@
+#pragma once
+// Reprojection residuals with analytic Jacobians (pose blocks use SE3LeftManifold, se3.h).
+//
+// Monocular: r = sqrt(inv_sigma2) * (pi(p_c) - uv), 2 rows.
+// RGB-D ("stereo" in ORB-SLAM2): a third row for the virtual right coordinate
+//   u_r = fx x/z + cx - bf/z, compared with the keypoint's u - bf/depth.
+// chi2 = |r|^2 is compared with 5.991 (2 dof) / 7.815 (3 dof) at 95%.
+#include "yolo_slam/common/camera.h"
+
+#include <ceres/sized_cost_function.h>
+#include <cmath>
+#include <Eigen/Core>
+
+namespace yolo_slam {
+namespace optimization {
+
+constexpr double kChi2Mono = 5.991;
+constexpr double kChi2Stereo = 7.815;
+
+struct Intrinsics {
+  double fx, fy, cx, cy, bf;
+  static Intrinsics from(const CameraModel& c) { return {c.fx, c.fy, c.cx, c.cy, c.bf}; }
+};
+
+// Shared residual/Jacobian code. kRows = 2 (mono) or 3 (stereo). Returns false when the point
+// lies on the camera plane (|z| tiny); the solver then rejects that step.
+template <int kRows>
+bool reprojectionResidual(const Intrinsics& K, const double* pose, const Eigen::Vector3d& Xw,
+                          const double* obs, double sqrt_info, double* residuals,
+                          double* jac_pose /* kRows x 7 row-major or null */,
+                          double* jac_point /* kRows x 3 row-major or null */);
+
+// Camera point and squared error (chi2, information-weighted) without Jacobians.
+struct ReprojectionCheck {
+  double chi2;
+  double depth;  // z of the point in the camera
+};
+ReprojectionCheck checkReprojection(const Intrinsics& K, const double* pose,
+                                    const Eigen::Vector3d& Xw, const Eigen::Vector2d& uv,
+                                    double u_right, double inv_sigma2);
+
+// Pose-only: the 3D point is a constant. `active` (may be null) lets the pose optimizer switch
+// an observation off without rebuilding the problem: an inactive residual is 0 with zero
+// Jacobian (ORB-SLAM2's "level 1" edges).
+template <int kRows>
+class PoseOnlyCost final : public ceres::SizedCostFunction<kRows, 7> {
+ public:
+  PoseOnlyCost(const Intrinsics& K, const Eigen::Vector3d& Xw, const Eigen::Matrix<double, kRows, 1>& obs,
+               double inv_sigma2, const bool* active)
+      : K_(K), Xw_(Xw), obs_(obs), sqrt_info_(std::sqrt(inv_sigma2)), active_(active) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    if (active_ && !*active_) {
+      for (int i = 0; i < kRows; ++i) residuals[i] = 0.0;
+      if (jacobians && jacobians[0]) {
+        for (int i = 0; i < kRows * 7; ++i) jacobians[0][i] = 0.0;
+      }
+      return true;
+    }
+    return reprojectionResidual<kRows>(K_, parameters[0], Xw_, obs_.data(), sqrt_info_, residuals,
+                                       jacobians ? jacobians[0] : nullptr, nullptr);
+  }
+
+ private:
+  Intrinsics K_;
+  Eigen::Vector3d Xw_;
+  Eigen::Matrix<double, kRows, 1> obs_;
+  double sqrt_info_;
+  const bool* active_;
+};
+
+// Bundle adjustment: pose block (7, SE3LeftManifold) and point block (3).
+template <int kRows>
+class BaCost final : public ceres::SizedCostFunction<kRows, 7, 3> {
+ public:
+  BaCost(const Intrinsics& K, const Eigen::Matrix<double, kRows, 1>& obs, double inv_sigma2)
+      : K_(K), obs_(obs), sqrt_info_(std::sqrt(inv_sigma2)) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return reprojectionResidual<kRows>(K_, parameters[0], Eigen::Map<const Eigen::Vector3d>(parameters[1]),
+                                       obs_.data(), sqrt_info_, residuals,
+                                       jacobians ? jacobians[0] : nullptr,
+                                       jacobians ? jacobians[1] : nullptr);
+  }
+
+ private:
+  Intrinsics K_;
+  Eigen::Matrix<double, kRows, 1> obs_;
+  double sqrt_info_;
+};
+
+}  // namespace optimization
+}  // namespace yolo_slam
