@@ -22,9 +22,9 @@ std::string toString(Weighting w) {
 
 std::shared_ptr<Vocabulary> Vocabulary::fromNodes(int k, int levels, Weighting weighting,
                                                   Scoring scoring,
-                                                  const std::vector<uint32_t>& parents,
-                                                  const std::vector<uint8_t>& descriptors,
-                                                  const std::vector<double>& weights,
+                                                  std::vector<uint32_t> parents,
+                                                  std::vector<uint8_t> descriptors,
+                                                  std::vector<double> weights,
                                                   std::vector<uint32_t> word_ids,
                                                   const std::string& name) {
   const size_t n = parents.size();
@@ -72,9 +72,9 @@ std::shared_ptr<Vocabulary> Vocabulary::fromNodes(int k, int levels, Weighting w
   v->weighting_ = weighting;
   v->scoring_ = scoring;
   if (ordered) {
-    v->parent_ = parents;
-    v->desc_ = descriptors;
-    v->weight_ = weights;
+    v->parent_ = std::move(parents);
+    v->desc_ = std::move(descriptors);
+    v->weight_ = std::move(weights);
     v->word_of_node_ = std::move(word_ids);
   } else {
     std::vector<uint32_t> new_of_old(n);

@@ -13,7 +13,7 @@
 //       36     4  word count
 //       40     4  flags (0; reserved for compression)
 //       44     8  payload size in bytes (= n * 44)
-//       52     8  checksum of the payload (see payloadChecksum)
+//       52     8  checksum of the payload (see PayloadChecksum)
 //       60        payload: parent u32[n], descriptors u8[n][32], weight f64[n], word id u32[n]
 //                 (word id 0xffffffff for inner nodes); nodes breadth-first, children contiguous.
 // Loading is one read plus memcpy of each array (no parsing), so 10^6 words load in well under
@@ -32,7 +32,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <sys/stat.h>
 
 namespace yolo_slam {
 namespace vocabulary {
@@ -48,23 +50,43 @@ constexpr size_t kBytesPerNode = 4 + kDescriptorBytes + 8 + 4;
 
 // FNV-1a (64-bit offset basis and prime) applied to the payload's little-endian 64-bit words,
 // then to the remaining tail bytes one by one. Word-wise rather than byte-wise keeps it at
-// about 10 ms for a 50 MB payload.
-uint64_t payloadChecksum(const uint8_t* p, size_t n) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  const uint64_t prime = 0x100000001b3ull;
-  size_t i = 0;
-  for (; i + 8 <= n; i += 8) {
+// about 10 ms for a 50 MB payload. Streaming, so arrays can be hashed as they are read.
+class PayloadChecksum {
+ public:
+  void update(const uint8_t* p, size_t n) {
+    while (n > 0 && carry_n_ > 0) {  // complete a word started by the previous chunk
+      carry_[carry_n_++] = *p++;
+      --n;
+      if (carry_n_ == 8) {
+        word(carry_);
+        carry_n_ = 0;
+      }
+    }
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) word(p + i);
+    for (; i < n; ++i) carry_[carry_n_++] = p[i];
+  }
+  uint64_t finish() {
+    for (size_t i = 0; i < carry_n_; ++i) {
+      h_ ^= carry_[i];
+      h_ *= kPrime;
+    }
+    carry_n_ = 0;
+    return h_;
+  }
+
+ private:
+  static constexpr uint64_t kPrime = 0x100000001b3ull;
+  void word(const uint8_t* p) {
     uint64_t w;
-    std::memcpy(&w, p + i, 8);
-    h ^= w;
-    h *= prime;
+    std::memcpy(&w, p, 8);
+    h_ ^= w;
+    h_ *= kPrime;
   }
-  for (; i < n; ++i) {
-    h ^= p[i];
-    h *= prime;
-  }
-  return h;
-}
+  uint64_t h_ = 0xcbf29ce484222325ull;
+  uint8_t carry_[8] = {0};
+  size_t carry_n_ = 0;
+};
 
 template <typename T>
 void put(std::vector<uint8_t>& out, size_t& off, const T& v) {
@@ -101,7 +123,7 @@ std::vector<uint8_t> readWholeFile(const std::string& path) {
   FILE* f = std::fopen(path.c_str(), "rb");
   if (!f)
     throw Error(path + ": cannot open vocabulary (" + std::strerror(errno) +
-                "); pass the path of a vocabulary file (e.g. vocab/yolo_slam_orb.vocab) or "
+                "); pass the path of a vocabulary file (e.g. vocab/yolo_slam_orb_k10_L4.vocab) or "
                 "train one with yolo_slam_train_vocab");
   std::vector<uint8_t> buf;
   if (std::fseek(f, 0, SEEK_END) == 0) {
@@ -132,52 +154,78 @@ Scoring parseScoring(long v, const std::string& where) {
   return Scoring::L1;
 }
 
-bool hasBinaryMagic(const std::vector<uint8_t>& buf) {
-  return buf.size() >= sizeof(kMagic) && std::memcmp(buf.data(), kMagic, sizeof(kMagic)) == 0;
+struct FileCloser {
+  void operator()(FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<FILE, FileCloser>;
+
+FilePtr openForReading(const std::string& path) {
+  FilePtr f(std::fopen(path.c_str(), "rb"));
+  if (!f)
+    throw Error(path + ": cannot open vocabulary (" + std::strerror(errno) +
+                "); pass the path of a vocabulary file (e.g. vocab/yolo_slam_orb_k10_L4.vocab) or "
+                "train one with yolo_slam_train_vocab");
+  return f;
 }
 
-std::shared_ptr<Vocabulary> parseBinary(const std::vector<uint8_t>& buf, const std::string& path) {
-  if (!hasBinaryMagic(buf))
+bool startsWithMagic(const std::string& path) {
+  FilePtr f = openForReading(path);
+  char head[sizeof(kMagic)];
+  return std::fread(head, 1, sizeof(head), f.get()) == sizeof(head) &&
+         std::memcmp(head, kMagic, sizeof(kMagic)) == 0;
+}
+
+// Reads the header, then each node array straight into its vector (no intermediate buffer),
+// hashing as it goes.
+std::shared_ptr<Vocabulary> readBinary(const std::string& path) {
+  FilePtr f = openForReading(path);
+  uint8_t h[kHeaderBytes];
+  const size_t got = std::fread(h, 1, kHeaderBytes, f.get());
+  if (got < sizeof(kMagic) || std::memcmp(h, kMagic, sizeof(kMagic)) != 0)
     throw Error(path + ": not a yolo_slam binary vocabulary (bad magic)");
-  if (buf.size() < kHeaderBytes)
-    throw Error(path + ": truncated vocabulary header (" + std::to_string(buf.size()) +
+  if (got < kHeaderBytes)
+    throw Error(path + ": truncated vocabulary header (" + std::to_string(got) +
                 " bytes); the file is damaged, regenerate it (see vocab/README.md)");
-  const uint8_t* p = buf.data();
-  const uint32_t version = get<uint32_t>(p, 8);
+  const uint32_t version = get<uint32_t>(h, 8);
   if (version != kVersion)
     throw Error(path + ": vocabulary format version " + std::to_string(version) +
                 " is not supported (this build reads version " + std::to_string(kVersion) + ")");
-  const uint32_t k = get<uint32_t>(p, 12), levels = get<uint32_t>(p, 16);
-  const Weighting weighting = parseWeighting(get<uint32_t>(p, 20), path);
-  const Scoring scoring = parseScoring(get<uint32_t>(p, 24), path);
-  const uint32_t dbytes = get<uint32_t>(p, 28);
-  const uint32_t n = get<uint32_t>(p, 32), words = get<uint32_t>(p, 36), flags = get<uint32_t>(p, 40);
-  const uint64_t payload = get<uint64_t>(p, 44), checksum = get<uint64_t>(p, 52);
+  const uint32_t k = get<uint32_t>(h, 12), levels = get<uint32_t>(h, 16);
+  const Weighting weighting = parseWeighting(get<uint32_t>(h, 20), path);
+  const Scoring scoring = parseScoring(get<uint32_t>(h, 24), path);
+  const uint32_t dbytes = get<uint32_t>(h, 28);
+  const uint32_t n = get<uint32_t>(h, 32), words = get<uint32_t>(h, 36), flags = get<uint32_t>(h, 40);
+  const uint64_t payload = get<uint64_t>(h, 44), checksum = get<uint64_t>(h, 52);
   if (dbytes != kDescriptorBytes)
     throw Error(path + ": descriptor size " + std::to_string(dbytes) + " bytes, expected 32 (ORB)");
   if (flags != 0) throw Error(path + ": unknown vocabulary flags " + std::to_string(flags));
   if (payload != static_cast<uint64_t>(n) * kBytesPerNode)
     throw Error(path + ": header is inconsistent (payload size does not match node count)");
-  if (buf.size() - kHeaderBytes != payload)
+  struct stat st {};
+  if (::fstat(::fileno(f.get()), &st) != 0 || static_cast<uint64_t>(st.st_size) != kHeaderBytes + payload)
     throw Error(path + ": vocabulary is truncated or has trailing bytes (" +
-                std::to_string(buf.size() - kHeaderBytes) + " payload bytes, header says " +
-                std::to_string(payload) + "); regenerate it (see vocab/README.md)");
-  if (payloadChecksum(p + kHeaderBytes, payload) != checksum)
-    throw Error(path + ": vocabulary checksum mismatch: the file is corrupt; regenerate it (see "
-                "vocab/README.md)");
+                std::to_string(static_cast<long long>(st.st_size) - static_cast<long long>(kHeaderBytes)) +
+                " payload bytes, header says " + std::to_string(payload) +
+                "); regenerate it (see vocab/README.md)");
   std::vector<uint32_t> parents(n), word_ids(n);
   std::vector<uint8_t> desc(static_cast<size_t>(n) * kDescriptorBytes);
   std::vector<double> weights(n);
-  size_t off = kHeaderBytes;
-  std::memcpy(parents.data(), p + off, n * 4ull);
-  off += n * 4ull;
-  std::memcpy(desc.data(), p + off, desc.size());
-  off += desc.size();
-  std::memcpy(weights.data(), p + off, n * 8ull);
-  off += n * 8ull;
-  std::memcpy(word_ids.data(), p + off, n * 4ull);
+  PayloadChecksum sum;
+  auto readArray = [&](void* dst, size_t bytes) {
+    if (std::fread(dst, 1, bytes, f.get()) != bytes)
+      throw Error(path + ": vocabulary is truncated; regenerate it (see vocab/README.md)");
+    sum.update(static_cast<const uint8_t*>(dst), bytes);
+  };
+  readArray(parents.data(), n * 4ull);
+  readArray(desc.data(), desc.size());
+  readArray(weights.data(), n * 8ull);
+  readArray(word_ids.data(), n * 4ull);
+  if (sum.finish() != checksum)
+    throw Error(path + ": vocabulary checksum mismatch: the file is corrupt; regenerate it (see "
+                "vocab/README.md)");
   auto v = Vocabulary::fromNodes(static_cast<int>(k), static_cast<int>(levels), weighting, scoring,
-                                 parents, desc, weights, std::move(word_ids), path);
+                                 std::move(parents), std::move(desc), std::move(weights),
+                                 std::move(word_ids), path);
   if (v->size() != words)
     throw Error(path + ": header says " + std::to_string(words) + " words, the tree has " +
                 std::to_string(v->size()));
@@ -224,17 +272,10 @@ struct LineParser {
 
 }  // namespace
 
-std::shared_ptr<Vocabulary> Vocabulary::loadBinary(const std::string& path) {
-  return parseBinary(readWholeFile(path), path);
-}
+std::shared_ptr<Vocabulary> Vocabulary::loadBinary(const std::string& path) { return readBinary(path); }
 
 std::shared_ptr<Vocabulary> Vocabulary::load(const std::string& path) {
-  std::vector<uint8_t> buf = readWholeFile(path);
-  if (buf.empty()) throw Error(path + ": vocabulary file is empty");
-  if (hasBinaryMagic(buf)) return parseBinary(buf, path);
-  buf.clear();
-  buf.shrink_to_fit();
-  return loadText(path);
+  return startsWithMagic(path) ? readBinary(path) : loadText(path);
 }
 
 std::shared_ptr<Vocabulary> Vocabulary::loadText(const std::string& path) {
@@ -327,7 +368,9 @@ void Vocabulary::save(const std::string& path) const {
   std::memcpy(out.data() + off, weight_.data(), n * 8);
   off += n * 8;
   std::memcpy(out.data() + off, word_of_node_.data(), n * 4);
-  const uint64_t sum = payloadChecksum(out.data() + kHeaderBytes, payload);
+  PayloadChecksum hasher;
+  hasher.update(out.data() + kHeaderBytes, payload);
+  const uint64_t sum = hasher.finish();
   std::memcpy(out.data() + checksum_off, &sum, 8);
   writeAtomically(path, out.data(), out.size());
 }

@@ -42,9 +42,9 @@ class Vocabulary {
   // node order). Throws yolo_slam::Error (prefixed by `name`) if the arrays do not form a tree
   // with at most `levels` levels, or the word ids are not 0..W-1 exactly once.
   static std::shared_ptr<Vocabulary> fromNodes(int k, int levels, Weighting weighting, Scoring scoring,
-                                               const std::vector<uint32_t>& parents,
-                                               const std::vector<uint8_t>& descriptors,
-                                               const std::vector<double>& weights,
+                                               std::vector<uint32_t> parents,
+                                               std::vector<uint8_t> descriptors,
+                                               std::vector<double> weights,
                                                std::vector<uint32_t> word_ids,
                                                const std::string& name = "<vocabulary>");
 
