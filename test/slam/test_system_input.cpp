@@ -1,0 +1,118 @@
+// System robustness to bad per-frame input: no depth, black/saturated images, NaN depth,
+// mismatched depth, empty images, timestamp jumps. Tracking reports lost (or not initialised),
+// never crashes and never outputs a non-finite pose.
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/slam/system.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <limits>
+
+using namespace yolo_slam;
+using namespace yolo_slam::slam;
+
+namespace {
+
+SystemOptions offOptions() {
+  SystemOptions o = SystemOptions::load(Config());
+  o.screening.mode = screening::DynamicMode::Off;
+  return o;
+}
+
+// A textured image (smoothed noise) and a plane 2 m away.
+cv::Mat texture(unsigned seed) {
+  cv::Mat img(480, 640, CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(img, img, cv::Size(5, 5), 1.5);
+  return img;
+}
+
+void expectFinite(const Trajectory& t) {
+  for (const auto& p : t) {
+    EXPECT_TRUE(std::isfinite(p.stamp));
+    EXPECT_TRUE(p.T_wc.matrix().allFinite());
+  }
+}
+
+}  // namespace
+
+TEST(SlamSystem, BadFramesReportLostWithoutCrash) {
+  CameraModel cam;
+  System sys(cam, offOptions(), nullptr);
+  const cv::Mat img = texture(1);
+  const cv::Mat plane(480, 640, CV_32F, cv::Scalar(2.0f));
+  double t = 0;
+  auto track = [&](const cv::Mat& im, const cv::Mat& d) {
+    t += 1.0 / 30;
+    return sys.trackRgbd(im, d, t, {});
+  };
+  // Before initialisation: no depth, black, saturated, NaN depth, wrong depth size, empty image.
+  EXPECT_NE(track(img, cv::Mat()).state, TrackingState::Ok);
+  EXPECT_NE(track(cv::Mat::zeros(480, 640, CV_8UC3), plane).state, TrackingState::Ok);
+  EXPECT_NE(track(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(255)), plane).state, TrackingState::Ok);
+  cv::Mat nan_depth(480, 640, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_NE(track(img, nan_depth).state, TrackingState::Ok);
+  EXPECT_NE(track(img, cv::Mat(100, 100, CV_32F, cv::Scalar(2.0f))).state, TrackingState::Ok);
+  EXPECT_NE(track(cv::Mat(), plane).state, TrackingState::Ok);
+  EXPECT_NE(track(img, cv::Mat(480, 640, CV_16U, cv::Scalar(1000))).state, TrackingState::Ok);
+  EXPECT_TRUE(sys.cameraTrajectory().empty());
+
+  // A good frame initialises; the same view again tracks.
+  TrackResult r = track(img, plane);
+  ASSERT_EQ(r.state, TrackingState::Ok);
+  EXPECT_TRUE(r.T_wc.matrix().allFinite());
+  EXPECT_EQ(track(img, plane).state, TrackingState::Ok);
+
+  // After initialisation: black frames are lost, then the view comes back and is tracked
+  // again (against the last keyframe), also across a timestamp jump.
+  for (int k = 0; k < 3; ++k) {
+    TrackResult lost = track(cv::Mat::zeros(480, 640, CV_8UC3), plane);
+    EXPECT_EQ(lost.state, TrackingState::Lost);
+  }
+  EXPECT_EQ(track(img, nan_depth).state == TrackingState::Ok ||
+                track(img, nan_depth).state == TrackingState::Lost,
+            true);
+  t += 100.0;  // jump in timestamps
+  TrackResult back = track(img, plane);
+  EXPECT_EQ(back.state, TrackingState::Ok);
+  // A timestamp going backwards is handled too.
+  t -= 50.0;
+  EXPECT_NE(track(img, plane).state, TrackingState::NotInitialized);
+
+  sys.waitForLocalMapping();
+  const Trajectory traj = sys.cameraTrajectory();
+  expectFinite(traj);
+  expectFinite(sys.keyframeTrajectory());
+  SystemStats s = sys.stats();
+  EXPECT_EQ(s.frames, s.tracked + s.lost);
+  EXPECT_EQ(traj.size(), s.tracked);
+  EXPECT_GE(s.lost, 10u);
+  // Shutdown is idempotent, tracking after it is refused politely.
+  sys.shutdown();
+  sys.shutdown();
+  EXPECT_NE(sys.trackRgbd(img, plane, t + 1, {}).state, TrackingState::Ok);
+}
+
+TEST(SlamSystem, ResetAndLocalizationMode) {
+  CameraModel cam;
+  System sys(cam, offOptions(), nullptr);
+  const cv::Mat img = texture(2);
+  const cv::Mat plane(480, 640, CV_32F, cv::Scalar(2.0f));
+  ASSERT_EQ(sys.trackRgbd(img, plane, 0.0, {}).state, TrackingState::Ok);
+  sys.waitForLocalMapping();
+  EXPECT_GE(sys.stats().keyframes, 1u);
+  EXPECT_GT(sys.mapSnapshot().points.size(), 100u);
+  sys.setLocalizationOnly(true);
+  EXPECT_TRUE(sys.localizationOnly());
+  for (int k = 1; k <= 5; ++k) EXPECT_EQ(sys.trackRgbd(img, plane, k / 30.0, {}).state, TrackingState::Ok);
+  sys.setLocalizationOnly(false);
+  sys.reset();
+  EXPECT_EQ(sys.stats().keyframes, 0u);
+  EXPECT_TRUE(sys.cameraTrajectory().empty());
+  EXPECT_EQ(sys.trackRgbd(img, plane, 1.0, {}).state, TrackingState::Ok);
+  const std::string js = sys.statsJson();
+  EXPECT_NE(js.find("\"frames\": 7"), std::string::npos) << js;
+}
