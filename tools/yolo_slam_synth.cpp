@@ -21,8 +21,8 @@ static void usage() {
       "                       [--trajectory static|xyz|rpy|halfsphere|loop|FILE] [--config FILE]\n"
       "                       [--motion-blur] [--no-noise] [--threads N]\n"
       "       yolo_slam_synth --list-presets | --list-textures [--textures DIR]\n"
-      "       yolo_slam_synth --contact-sheet PNG [--preset NAME ...]  (rgb, depth, mask of frames\n"
-      "                       0, 300, 600 of each preset; all presets by default)\n"
+      "       yolo_slam_synth --contact-sheet PNG [--preset NAME ...]  (rgb, depth, mask of frames 0\n"
+      "                       and 300 of each preset; all presets by default)\n"
       "Writes a TUM-format RGB-D sequence (rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt,\n"
       "associations.txt, camera.yaml) with dynamic ground truth (masks/, boxes.txt).\n"
       "Presets: walking_xyz (default) walking_static walking_rpy walking_half sitting_static\n"
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
     if (!sheet.empty()) {
       if (sheet_presets.empty())
         for (const auto& p : sim::presets()) sheet_presets.push_back(p.name);
-      cv::Mat img = sim::contactSheet(opt, sheet_presets, {0, 300, 600}, 200);
+      cv::Mat img = sim::contactSheet(opt, sheet_presets, {0, 300}, 200);
       if (!cv::imwrite(sheet, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
         throw Error("cannot write contact sheet " + sheet + ": check the folder exists and is writable");
       return 0;

@@ -134,18 +134,18 @@ void buildRoom(const std::vector<Texture>& tex, std::vector<Quad>& q) {
   const double x0 = -3.5, x1 = 3.5, y0 = -2.5, y1 = 5.2, h = 2.8;
   // Floor: dark warm carpet tiles; ceiling: pale panels; walls: pale, low-saturation panels
   // (photographs graded like painted or papered walls); furniture keeps natural colours.
-  b.grade(0.25f, cv::Vec3f(0.55f, 0.68f, 0.8f));
+  b.grade(0.12f, cv::Vec3f(0.42f, 0.52f, 0.62f));
   b.grid(V(x0, y0, 0), V(x1 - x0, 0, 0), V(0, y1 - y0, 0), 1.9, 1.0f, 0.1f);
-  b.grade(0.1f, cv::Vec3f(1.05f, 1.05f, 1.05f));
+  b.grade(0.05f, cv::Vec3f(1.1f, 1.1f, 1.1f));
   b.grid(V(x0, y1, h), V(x1 - x0, 0, 0), V(0, y0 - y1, 0), 2.6, 1.0f, 0.05f);
-  b.grade(0.35f, cv::Vec3f(0.95f, 1.05f, 1.12f));
+  b.grade(0.2f, cv::Vec3f(1.0f, 1.1f, 1.18f));
   b.grid(V(x0, y1, 0), V(x1 - x0, 0, 0), V(0, 0, h), 1.4, 1.0f, 0.1f);   // front
   b.grid(V(x1, y0, 0), V(x0 - x1, 0, 0), V(0, 0, h), 1.4, 0.95f, 0.1f);  // back
-  b.grade(0.35f, cv::Vec3f(1.1f, 1.05f, 0.95f));
+  b.grade(0.2f, cv::Vec3f(1.15f, 1.1f, 1.0f));
   b.grid(V(x0, y0, 0), V(0, y1 - y0, 0), V(0, 0, h), 1.4, 0.9f, 0.1f);   // left
   b.grid(V(x1, y1, 0), V(0, y0 - y1, 0), V(0, 0, h), 1.4, 0.9f, 0.1f);   // right
   // Two desks in front: top slab, modesty panel and side panels (light wood-like grading).
-  b.grade(0.3f, cv::Vec3f(0.75f, 0.9f, 1.05f));
+  b.grade(0.25f, cv::Vec3f(0.7f, 0.88f, 1.05f));
   for (double cx : {-0.85, 0.85}) {
     b.box(V(cx - 0.8, 3.0, 0.71), V(cx + 0.8, 3.8, 0.75), 1.0f);
     b.box(V(cx - 0.78, 3.02, 0.25), V(cx + 0.78, 3.06, 0.71), 0.8f);

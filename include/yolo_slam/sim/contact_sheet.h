@@ -1,6 +1,6 @@
 #pragma once
-// A contact sheet of synthetic sequences: per row one frame of a preset as rgb (with the
-// ground-truth boxes), colourised sensor depth (black = no reading) and the dynamic mask.
+// A contact sheet of synthetic sequences: one row per preset holding, for each chosen frame,
+// rgb (with the ground-truth boxes), colourised sensor depth (black = no reading) and the mask.
 #include "yolo_slam/sim/generator.h"
 
 #include <opencv2/core.hpp>
