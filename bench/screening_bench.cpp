@@ -1,5 +1,8 @@
 // Screening benchmark on the real TUM fr3_walking_xyz frame with its person mask (shared data):
 //   screening_bench [--reps N] [--detector] [--sweep] [--seeds S] [--border PX]
+//   screening_bench --sequence DIR [--stride N] [--detector]
+// --sequence: quality of several configurations over every N-th frame of a yolo_slam_synth
+// sequence (exact masks/, boxes from boxes.txt or from the detector).
 // Prints the time per frame of Screener::screen for each mode and variant (median over N
 // repetitions) and the quality against the mask: dynamic recall (mask keypoints dropped) and
 // static retention (non-mask keypoints inside boxes kept). --sweep prints the nThre table of
@@ -7,6 +10,7 @@
 // S seeds. Boxes come from the mask's connected components, or from the YOLO detector with
 // --detector (default model, see detection/detector.h).
 #include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/timing.h"
@@ -20,6 +24,9 @@
 
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -175,6 +182,13 @@ void sweep(const RealFrame& rf, int seeds) {
       }
     }
   }
+  std::printf("\n| defaults with box dilation | dynamic recall | static kept in boxes | dropped |\n|---|---|---|---|\n");
+  for (double dil : {0.0, 0.05, 0.1, 0.2}) {
+    ScreeningOptions o;
+    o.box_dilation = dil;
+    Quality q = quality(rf, o, seeds);
+    std::printf("| %.2f | %.3f | %.3f | %.1f |\n", dil, q.recall, q.retention, q.dropped);
+  }
   ScreeningOptions d;
   d.mode = DynamicMode::Detect;
   Quality qd = quality(rf, d, 1);
@@ -210,12 +224,121 @@ void timing(const RealFrame& rf, int reps) {
   }
 }
 
+// A synthetic sequence of yolo_slam_synth: associations.txt, masks/<rgb name>.png and
+// boxes.txt ("rgb_stamp id class x1 y1 x2 y2 visible_fraction", x2/y2 exclusive).
+void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
+  std::ifstream assoc(joinPath(dir, "associations.txt"));
+  if (!assoc) throw Error(joinPath(dir, "associations.txt") + ": not found; pass a yolo_slam_synth output folder");
+  std::map<std::string, detection::Boxes> gt_boxes;
+  {
+    const std::string path = joinPath(dir, "boxes.txt");
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": not found; --sequence needs a synthetic sequence with boxes.txt");
+    std::string line;
+    int ln = 0;
+    while (std::getline(in, line)) {
+      ++ln;
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream is(line);
+      std::string stamp, cls;
+      int id;
+      float x1, y1, x2, y2, vis;
+      if (!(is >> stamp >> id >> cls >> x1 >> y1 >> x2 >> y2 >> vis))
+        throw Error(path + ":" + std::to_string(ln) + ": malformed line; expected 'stamp id class x1 y1 x2 y2 visible'");
+      detection::Box b;
+      b.label = cls;
+      b.score = 1.f;
+      b.rect = cv::Rect2f(x1, y1, x2 - x1, y2 - y1);
+      gt_boxes[stamp].push_back(b);
+    }
+  }
+  struct Cfg {
+    std::string name;
+    ScreeningOptions o;
+  };
+  std::vector<Cfg> cfgs;
+  auto add = [&](const std::string& name, ScreeningVariant v, double thr,
+                 ScreeningOptions::NoDepthRule nd, double dil = 0.0) {
+    ScreeningOptions o;
+    o.variant = v;
+    o.variance_threshold_m2 = thr;
+    o.no_depth = nd;
+    o.box_dilation = dil;
+    cfgs.push_back({name, o});
+  };
+  using NDR = ScreeningOptions::NoDepthRule;
+  add("paper 0.43 m^2", ScreeningVariant::Paper, 0.43, NDR::Dynamic);
+  add("paper 0.185 m^2 (0.43 m std)", ScreeningVariant::Paper, 0.185, NDR::Dynamic);
+  add("paper 0.1", ScreeningVariant::Paper, 0.1, NDR::Dynamic);
+  add("paper 0.02", ScreeningVariant::Paper, 0.02, NDR::Dynamic);
+  add("paper 0.0043 (0.43 dm^2)", ScreeningVariant::Paper, 0.0043, NDR::Dynamic);
+  add("grow 0.1", ScreeningVariant::Grow, 0.1, NDR::Dynamic);
+  add("grow 0.05", ScreeningVariant::Grow, 0.05, NDR::Dynamic);
+  add("grow 0.02", ScreeningVariant::Grow, 0.02, NDR::Dynamic);
+  add("grow 0.02 noDepth static", ScreeningVariant::Grow, 0.02, NDR::Static);
+  add("grow 0.02 noDepth nearest", ScreeningVariant::Grow, 0.02, NDR::Nearest);
+  add("grow 0.02 dilation 0.05 (default)", ScreeningVariant::Grow, 0.02, NDR::Dynamic, 0.05);
+  add("grow 0.005", ScreeningVariant::Grow, 0.005, NDR::Dynamic);
+  add("paper 0.02 noDepth nearest", ScreeningVariant::Paper, 0.02, NDR::Nearest);
+  add("grow 0.05 noDepth nearest", ScreeningVariant::Grow, 0.05, NDR::Nearest);
+  add("grow 0.1 noDepth nearest", ScreeningVariant::Grow, 0.1, NDR::Nearest);
+  add("paper 0.43 noDepth nearest", ScreeningVariant::Paper, 0.43, NDR::Nearest);
+  std::vector<ScreeningMetrics> total(cfgs.size());
+  ScreeningMetrics det_total;
+
+  CameraModel cam = CameraModel::load(Config::fromFile(joinPath(dir, "camera.yaml")));
+  features::OrbExtractor orb{features::OrbOptions{}};
+  std::unique_ptr<detection::Detector> det;
+  if (use_detector) det = detection::makeDetector(detection::DetectorOptions{});
+  std::string line;
+  int idx = 0, used = 0;
+  while (std::getline(assoc, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (idx++ % stride) continue;
+    std::istringstream is(line);
+    std::string rgb_stamp, rgb_rel, depth_stamp, depth_rel;
+    if (!(is >> rgb_stamp >> rgb_rel >> depth_stamp >> depth_rel)) continue;
+    cv::Mat bgr = cv::imread(joinPath(dir, rgb_rel), cv::IMREAD_COLOR);
+    cv::Mat raw = cv::imread(joinPath(dir, depth_rel), cv::IMREAD_ANYDEPTH);
+    if (bgr.empty() || raw.empty()) throw Error(joinPath(dir, rgb_rel) + ": missing or unreadable frame");
+    cv::Mat depth_m;
+    raw.convertTo(depth_m, CV_32F, 1.0 / cam.depth_map_factor);
+    const std::string name = rgb_rel.substr(rgb_rel.find_last_of('/') + 1);
+    cv::Mat mask = loadMask(joinPath(dir, "masks/" + name));
+    CameraModel c = cam;
+    c.rgb_order = false;  // cv::imread gives BGR
+    features::FeatureFrame frame = features::buildFeatureFrame(orb, c, bgr, depth_m, 0.0);
+    detection::Boxes boxes = det ? det->detect(bgr) : gt_boxes[rgb_stamp];
+    for (size_t k = 0; k < cfgs.size(); ++k) {
+      features::FeatureFrame f = frame;
+      Screener(cfgs[k].o).screen(f, boxes);
+      total[k] += evaluateScreening(f, mask, boxes);
+    }
+    ScreeningOptions d;
+    d.mode = DynamicMode::Detect;
+    features::FeatureFrame f = frame;
+    Screener(d).screen(f, boxes);
+    det_total += evaluateScreening(f, mask, boxes);
+    ++used;
+  }
+  std::printf("\n%s: %d frames (every %d), %s boxes\n", dir.c_str(), used, stride,
+              use_detector ? "detector" : "ground-truth");
+  std::printf("| configuration | dynamic keypoints | dynamic recall | static in boxes | static kept in boxes |\n|---|---|---|---|---|\n");
+  for (size_t k = 0; k < cfgs.size(); ++k)
+    std::printf("| %s | %d | %.3f | %d | %.3f |\n", cfgs[k].name.c_str(), total[k].dynamic_total,
+                total[k].dynamicRecall(), total[k].static_in_boxes, total[k].staticRetention());
+  std::printf("| mode detect | %d | %.3f | %d | %.3f |\n", det_total.dynamic_total,
+              det_total.dynamicRecall(), det_total.static_in_boxes, det_total.staticRetention());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
     int reps = 200, seeds = 20;
     bool use_detector = false, do_sweep = false;
+    std::string sequence;
+    int stride = 10;
     for (int i = 1; i < argc; ++i) {
       std::string a = argv[i];
       auto next = [&]() -> std::string {
@@ -227,9 +350,15 @@ int main(int argc, char** argv) {
       else if (a == "--detector") use_detector = true;
       else if (a == "--sweep") do_sweep = true;
       else if (a == "--border") g_border = std::stoi(next());
+      else if (a == "--sequence") sequence = next();
+      else if (a == "--stride") stride = std::stoi(next());
       else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep]");
     }
-    if (reps < 1 || seeds < 1) throw Error("--reps and --seeds must be >= 1");
+    if (reps < 1 || seeds < 1 || stride < 1) throw Error("--reps, --seeds and --stride must be >= 1");
+    if (!sequence.empty()) {
+      sequenceSweep(sequence, stride, use_detector);
+      return 0;
+    }
     RealFrame rf = loadRealFrame(use_detector);
     printCounts(rf);
     if (do_sweep) sweep(rf, seeds);

@@ -8,6 +8,7 @@
 #include "yolo_slam/screening/screener.h"
 
 #include <gtest/gtest.h>
+#include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 
 using namespace yolo_slam;
@@ -86,15 +87,18 @@ TEST(RealFrame, DefaultDropsPeopleAndKeepsDeskAndWall) {
     EXPECT_EQ(c.second, 0) << "static region " << still;
   }
 
-  // Against the whole mask (measured with screening_bench: recall 0.88, retention 0.78 with
-  // the mask as published; 0.93 / 0.87 leaving out a 10 px band around its loose boundary).
+  // Against the whole mask (defaults, seed 0: recall 0.879, retention 0.780 with the mask as
+  // published; 0.931 / 0.862 leaving out a 10 px band around its loose boundary, where depth
+  // and mask disagree; screening_bench --sweep averages 20 seeds: 0.869 / 0.736).
   ScreeningMetrics m = evaluateScreening(f, r.mask, r.boxes);
   EXPECT_GT(m.dynamic_total, 400);
-  EXPECT_GE(m.dynamicRecall(), 0.85);
-  EXPECT_GE(m.staticRetention(), 0.72);
+  EXPECT_GE(m.dynamicRecall(), 0.84);
+  EXPECT_GE(m.staticRetention(), 0.70);
   ScreeningMetrics core = evaluateScreening(f, r.mask, r.boxes, 10);
-  EXPECT_GE(core.dynamicRecall(), 0.90);
-  EXPECT_GE(core.staticRetention(), 0.80);
+  EXPECT_GE(core.dynamicRecall(), 0.89);
+  EXPECT_GE(core.staticRetention(), 0.76);
+  std::printf("real frame, defaults: recall %.3f retention %.3f; 10 px border left out: %.3f %.3f\n",
+              m.dynamicRecall(), m.staticRetention(), core.dynamicRecall(), core.staticRetention());
 }
 
 TEST(RealFrame, PaperThresholdReadAsSquareMetresSwallowsTheDesk) {
@@ -122,6 +126,7 @@ TEST(RealFrame, DetectModeDropsEverythingInBoxes) {
   features::FeatureFrame f = r.frame;
   ScreeningOptions o;
   o.mode = DynamicMode::Detect;
+  o.box_dilation = 0;
   ScreeningStats st = Screener(o).screen(f, r.boxes);
   EXPECT_EQ(st.kept, 0);
   EXPECT_EQ(st.dropped, st.in_boxes);

@@ -190,7 +190,7 @@ TEST(Options, ParseAndLoad) {
   Config c = Config::fromString(
       "Screening.mode: \"detect\"\nScreening.variant: \"paper\"\nScreening.varianceThreshold: 0.2\n"
       "Screening.probability: 0.95\nScreening.maxIterations: 77\nScreening.seed: 5\n"
-      "Screening.noDepth: \"static\"\nScreening.boxDilation: 0.05\n", "s.yaml");
+      "Screening.noDepth: \"static\"\nScreening.boxDilation: 0.1\n", "s.yaml");
   ScreeningOptions o = ScreeningOptions::load(c);
   EXPECT_EQ(o.mode, DynamicMode::Detect);
   EXPECT_EQ(o.variant, ScreeningVariant::Paper);
@@ -199,7 +199,7 @@ TEST(Options, ParseAndLoad) {
   EXPECT_EQ(o.max_iterations, 77);
   EXPECT_EQ(o.seed, 5u);
   EXPECT_EQ(o.no_depth, ScreeningOptions::NoDepthRule::Static);
-  EXPECT_DOUBLE_EQ(o.box_dilation, 0.05);
+  EXPECT_DOUBLE_EQ(o.box_dilation, 0.1);
 
   ScreeningOptions d = ScreeningOptions::load(Config());
   EXPECT_EQ(d.mode, DynamicMode::DetectGeometry);

@@ -53,7 +53,9 @@ struct ScreeningOptions {
   // of the nearest in-box keypoint with depth (within grow_radius_px; static if none).
   enum class NoDepthRule { Dynamic, Static, Nearest };
   NoDepthRule no_depth = NoDepthRule::Dynamic;
-  double box_dilation = 0.0;    // grow each box by this fraction of its width/height per side
+  // Grow each box by this fraction of its width/height per side: detector boxes clip heads
+  // and feet (measured gain with detector boxes, docs/screening.md).
+  double box_dilation = 0.05;
   double grow_radius_px = 30;   // grow variant: pixel radius of the linkage
   double grow_depth_m = 0.1;    // grow variant: depth difference of the linkage (metres)
 
