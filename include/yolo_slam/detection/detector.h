@@ -26,9 +26,13 @@ struct DetectorOptions {
   std::string model = defaultModelPath();
   int input_width = 0, input_height = 0;  // 0 = the model's native size
   bool letterbox = false;                 // keep aspect ratio with padding instead of stretching
+  // Darknet models: OpenCV 4.6's region layer zeroes class scores <= 0.2 itself, so lower
+  // thresholds act like 0.2 there.
   float conf_threshold = 0.3f;
   float nms_threshold = 0.45f;
-  int threads = 2;                        // cv::setNumThreads for the forward pass
+  // cv::setNumThreads before each forward pass. OpenCV's thread count is process-wide: it also
+  // applies to other OpenCV calls made meanwhile in other threads.
+  int threads = 2;
   std::vector<std::string> dynamic_classes{"person"};  // class names kept (from the names file)
 
   // Keys: Detector.model, Detector.inputWidth, Detector.inputHeight, Detector.letterbox,
