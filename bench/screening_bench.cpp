@@ -352,7 +352,7 @@ int main(int argc, char** argv) {
       else if (a == "--border") g_border = std::stoi(next());
       else if (a == "--sequence") sequence = next();
       else if (a == "--stride") stride = std::stoi(next());
-      else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep]");
+      else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep] [--border PX] | --sequence DIR [--stride N] [--detector]");
     }
     if (reps < 1 || seeds < 1 || stride < 1) throw Error("--reps, --seeds and --stride must be >= 1");
     if (!sequence.empty()) {
