@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# Ablation benchmark of the dynamic-feature modes (issue 7, item 5): the paper's Table 3
+# (ORB-SLAM2 / D / G / D+G) on the synthetic TUM-analogue presets, plus RPE, tracking and time.
+#
+#   bench/ablation.sh [--bin DIR] [--frames N] [--runs R] [--presets "a b c"] [--modes "..."]
+#                     [--out DIR] [--seed S] [--timeout SEC] [--table-only]
+#
+# A mode may carry the suffix ":gt" (e.g. "detect+geometry:gt"): person boxes then come from
+# the sequence's ground-truth boxes.txt instead of the detector, which separates detection
+# misses from screening/tracking errors.
+# Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
+# OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
+# evaluated with yolo_slam_eval (ATE, RPE delta 1 s); bench/ablation_table.py takes the medians
+# and writes OUT/table.md. A failed run is logged and shown as failed in the table; the script
+# carries on.
+set -u
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+repo="$(cd "$here/.." && pwd)"
+bin="$repo/build/ws/devel/lib/yolo_slam"
+frames=0
+runs=3
+presets="walking_xyz walking_static walking_rpy walking_half sitting_static static_xyz"
+modes="off detect geometry detect+geometry"
+out="$repo/out/ablation"
+seed=1
+timeout_s=3600
+table_only=0
+
+usage() {
+  sed -n '2,15p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  echo "defaults: --bin build/ws/devel/lib/yolo_slam --frames 0 (preset length) --runs 3 --seed 1"
+  echo "          --presets \"$presets\""
+  echo "          --modes \"$modes\" --out out/ablation --timeout 3600 (per run, seconds)"
+}
+
+need() { [ $# -ge 2 ] && [ -n "$2" ] || { echo "error: $1 needs a value; see --help" >&2; exit 1; }; }
+posint() { [[ "$2" =~ ^[0-9]+$ ]] && [ "$2" -ge "$3" ] || { echo "error: $1 must be an integer >= $3 (got '$2')" >&2; exit 1; }; }
+
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) need "$@"; bin="$2"; shift 2 ;;
+    --frames) need "$@"; posint "$1" "$2" 0; frames="$2"; shift 2 ;;
+    --runs) need "$@"; posint "$1" "$2" 1; runs="$2"; shift 2 ;;
+    --presets) need "$@"; presets="$2"; shift 2 ;;
+    --modes) need "$@"; modes="$2"; shift 2 ;;
+    --out) need "$@"; out="$2"; shift 2 ;;
+    --seed) need "$@"; posint "$1" "$2" 0; seed="$2"; shift 2 ;;
+    --timeout) need "$@"; posint "$1" "$2" 1; timeout_s="$2"; shift 2 ;;
+    --table-only) table_only=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "error: unknown option '$1'; see --help" >&2; exit 1 ;;
+  esac
+done
+
+for m in $modes; do
+  case "${m%:gt}" in
+    off|detect|geometry|detect+geometry) ;;
+    *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry (optionally with :gt)" >&2; exit 1 ;;
+  esac
+done
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+if [ "$table_only" = 0 ]; then
+  for t in yolo_slam_synth yolo_slam_run yolo_slam_eval; do
+    [ -x "$bin/$t" ] || { echo "error: $bin/$t not found; build it (scripts/build.sh) or pass --bin DIR" >&2; exit 1; }
+  done
+fi
+mkdir -p "$out" || { echo "error: cannot create $out" >&2; exit 1; }
+out="$(cd "$out" && pwd)"
+
+log() { echo "[$(date +%H:%M:%S)] $*"; }
+
+# Everything needed to reproduce the table, read back by ablation_table.py.
+{
+  echo "command: bench/ablation.sh --frames $frames --runs $runs --presets \"$presets\" --modes \"$modes\" --seed $seed"
+  echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "commit: $(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$repo" diff --quiet HEAD -- src include tools 2>/dev/null || echo ' (+uncommitted changes in src/include/tools)')"
+  echo "bin: $bin"
+  echo "load_before: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
+  echo "cpus: $(nproc 2>/dev/null)"
+} > "$out/meta.txt.new"
+if [ "$table_only" = 1 ] && [ -f "$out/meta.txt" ]; then rm -f "$out/meta.txt.new"; else mv "$out/meta.txt.new" "$out/meta.txt"; fi
+
+if [ "$table_only" = 0 ]; then
+  for preset in $presets; do
+    seq="$out/seq/$preset"
+    want="preset=$preset frames=$frames seed=$seed"
+    if [ -f "$seq/.ablation_stamp" ] && [ "$(cat "$seq/.ablation_stamp")" = "$want" ]; then
+      log "$preset: reusing $seq"
+    else
+      log "$preset: generating ($want)"
+      rm -rf "$seq"
+      mkdir -p "$seq"
+      if "$bin/yolo_slam_synth" --preset "$preset" --frames "$frames" --seed "$seed" --threads 1 --out "$seq" \
+          > "$out/seq/$preset.log" 2>&1; then
+        echo "$want" > "$seq/.ablation_stamp"
+      else
+        log "$preset: generation FAILED (see $out/seq/$preset.log)"
+        continue
+      fi
+    fi
+    for mode in $modes; do
+      base="${mode%:gt}"
+      extra=()
+      [ "$mode" != "$base" ] && extra=(--boxes-from-gt)
+      for r in $(seq 1 "$runs"); do
+        dir="$out/runs/$preset/${mode/:/_}/run$r"
+        rm -rf "$dir"
+        mkdir -p "$dir"
+        echo "$mode" > "$dir/mode.txt"
+        t0=$(date +%s)
+        timeout -s TERM -k 60 "$timeout_s" "$bin/yolo_slam_run" --sequence "$seq" --config "$seq/camera.yaml" \
+          --out "$dir" --dynamic-mode "$base" "${extra[@]}" > "$dir/run.log" 2>&1
+        rc=$?
+        echo "$rc" > "$dir/rc.txt"
+        if [ "$rc" = 0 ] && [ -s "$dir/CameraTrajectory.txt" ]; then
+          "$bin/yolo_slam_eval" ate "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --json > "$dir/ate.json" 2> "$dir/eval.log" \
+            || rm -f "$dir/ate.json"
+          "$bin/yolo_slam_eval" rpe "$seq/groundtruth.txt" "$dir/CameraTrajectory.txt" --delta 1 --delta-unit s --json \
+            > "$dir/rpe.json" 2>> "$dir/eval.log" || rm -f "$dir/rpe.json"
+          ate=$(sed -n 's/.*"rmse": *\([-0-9.eE+]*\).*/\1/p' "$dir/ate.json" 2>/dev/null)
+          log "$preset $mode run $r: rc 0, $(( $(date +%s) - t0 )) s, ATE ${ate:-n/a} m"
+        else
+          log "$preset $mode run $r: FAILED rc $rc after $(( $(date +%s) - t0 )) s ($(tail -c 300 "$dir/run.log" | tr '\r\n' '  ' | sed 's/.*error:/error:/'))"
+        fi
+      done
+    done
+  done
+fi
+
+"$py" "$here/ablation_table.py" "$out" > "$out/table.md.new" && mv "$out/table.md.new" "$out/table.md" \
+  || { echo "error: ablation_table.py failed on $out" >&2; exit 1; }
+log "wrote $out/table.md"
