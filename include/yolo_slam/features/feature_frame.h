@@ -16,7 +16,10 @@ struct FeatureFrame {
   std::vector<cv::KeyPoint> keypoints_un;    // undistorted (equal to keypoints without distortion)
   cv::Mat descriptors;                       // N x 32 CV_8U, rotated BRIEF (256 bits)
   std::vector<float> depth;                  // metres per keypoint; <= 0 means no valid depth
-  std::vector<float> right_u;                // virtual right coordinate u - bf/d; < 0 if no depth
+  // Virtual right coordinate u_un - bf/d; -1 without depth. It can also be < 0 for a valid,
+  // very close depth near the left border: such keypoints get the monocular residual, as in
+  // ORB-SLAM2. Test depth > 0, not right_u, for "has depth".
+  std::vector<float> right_u;
   std::vector<uint8_t> dynamic;              // 1 = screened as dynamic (never used by SLAM)
 
   size_t size() const { return keypoints.size(); }
