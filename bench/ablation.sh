@@ -80,7 +80,8 @@ log() { echo "[$(date +%H:%M:%S)] $*"; }
   echo "load_before: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
   echo "cpus: $(nproc 2>/dev/null)"
 } > "$out/meta.txt.new"
-if [ "$table_only" = 1 ] && [ -f "$out/meta.txt" ]; then rm -f "$out/meta.txt.new"; else mv "$out/meta.txt.new" "$out/meta.txt"; fi
+# Several invocations may fill one OUT (e.g. a second one adding ":gt" modes): keep every block.
+if [ "$table_only" = 1 ]; then rm -f "$out/meta.txt.new"; else cat "$out/meta.txt.new" >> "$out/meta.txt"; rm -f "$out/meta.txt.new"; fi
 
 if [ "$table_only" = 0 ]; then
   for preset in $presets; do
@@ -129,6 +130,7 @@ if [ "$table_only" = 0 ]; then
   done
 fi
 
+[ "$table_only" = 0 ] && echo "finished: $(date -u +%Y-%m-%dT%H:%M:%SZ), load_after: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)" >> "$out/meta.txt"
 "$py" "$here/ablation_table.py" "$out" > "$out/table.md.new" && mv "$out/table.md.new" "$out/table.md" \
   || { echo "error: ablation_table.py failed on $out" >&2; exit 1; }
 log "wrote $out/table.md"
