@@ -26,6 +26,7 @@ double rangeDouble(const Config& cfg, const std::string& key, double def, double
 TrackingOptions TrackingOptions::load(const Config& cfg) {
   TrackingOptions o;
   o.init_min_keypoints = positiveInt(cfg, "Tracking.initMinKeyPoints", o.init_min_keypoints, 10);
+  o.init_min_depth_points = positiveInt(cfg, "Tracking.initMinDepthPoints", o.init_min_depth_points, 10);
   o.motion_window = positiveInt(cfg, "Tracking.motionWindow", o.motion_window, 1);
   o.local_window = positiveInt(cfg, "Tracking.localWindow", o.local_window, 1);
   o.min_inliers = positiveInt(cfg, "Tracking.minInliers", o.min_inliers, 6);

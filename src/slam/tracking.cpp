@@ -160,7 +160,9 @@ TrackResult Tracking::track(const features::FeatureFrame& ff) {
 }
 
 bool Tracking::initialize(Frame& F) {
-  if (F.countWithDepth() < opt_.init_min_keypoints) return false;
+  int n_static = 0;
+  for (int i = 0; i < F.N; ++i) n_static += F.dynamic[i] ? 0 : 1;
+  if (n_static < opt_.init_min_keypoints || F.countWithDepth() < opt_.init_min_depth_points) return false;
   F.setPose(has_last_good_ ? last_good_T_wc_.inverse() : Pose::Identity());
   auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
   computeBow(kf->f);

@@ -10,7 +10,10 @@ class Config;
 namespace slam {
 
 struct TrackingOptions {
-  int init_min_keypoints = 500;     // Tracking.initMinKeyPoints: keypoints with depth to initialise
+  // Initialisation as ORB-SLAM2 (N > 500), counting static keypoints only (screened ones are
+  // gone), and requiring enough of them with depth to seed a usable map.
+  int init_min_keypoints = 500;     // Tracking.initMinKeyPoints: static keypoints to initialise
+  int init_min_depth_points = 100;  // Tracking.initMinDepthPoints: of those, with valid depth
   int motion_window = 15;           // Tracking.motionWindow: projection radius (px, level 0) of the motion model
   int local_window = 3;             // Tracking.localWindow: radius factor for the local-map search (RGB-D: 3)
   int min_inliers = 30;             // Tracking.minInliers: below this after local-map tracking the frame fails
