@@ -72,7 +72,7 @@ class DetectorNodelet : public nodelet::Nodelet {
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++rejected_;
-      NODELET_ERROR_THROTTLE(1.0, "Detector: image rejected: %s", e.what());
+      if (throttle_.shouldLog(e.what())) NODELET_ERROR("Detector: image rejected: %s", e.what());
       return;
     }
     {
@@ -83,6 +83,7 @@ class DetectorNodelet : public nodelet::Nodelet {
   }
 
   bool enabled_ = true;
+  ErrorThrottle throttle_;
   std::unique_ptr<detection::Detector> detector_;  // used by the image callback only
   ::ros::Subscriber sub_;
   ::ros::Publisher pub_;

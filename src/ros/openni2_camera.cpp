@@ -138,7 +138,15 @@ class OpenNI2Camera : public nodelet::Nodelet {
 
   std::string lastError() const {
     const char* e = api_.extendedError ? api_.extendedError() : nullptr;
-    return e && *e ? std::string(e) : std::string("no details");
+    // OpenNI2's messages carry tabs and newlines; keep the ROS error on one line.
+    std::string s;
+    for (const char* p = e; p && *p; ++p) {
+      const bool space = *p == '\n' || *p == '\t' || *p == '\r' || *p == ' ';
+      if (space && (s.empty() || s.back() == ' ')) continue;
+      s += space ? ' ' : *p;
+    }
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    return s.empty() ? std::string("no details") : s;
   }
 
   // Sleeps up to `seconds`, returning early when the nodelet is unloaded.
@@ -187,7 +195,9 @@ class OpenNI2Camera : public nodelet::Nodelet {
       device_ = nullptr;
       why = from_file ? "cannot open the recording '" + oni_file_ + "' (" + lastError() +
                             "); check ~oni_file"
-                      : "no OpenNI2 device found for " + source_ + " (" + lastError() +
+                      : "no OpenNI2 device found" +
+                            (device_uri_.empty() ? std::string() : " at '" + device_uri_ + "'") +
+                            " (" + lastError() +
                             "); plug in a Kinect/Xtion or set ~oni_file to a recording";
       return false;
     }

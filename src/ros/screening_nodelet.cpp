@@ -12,7 +12,6 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
-#include <condition_variable>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -47,7 +46,6 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("queue_size", queue_size, 100);
     pnh.param("use_boxes", use_boxes_, true);
     pnh.param("use_camera_info", use_camera_info_, true);
-    pnh.param("camera_info_wait", camera_info_wait_, 1.0);
     pnh.param("depth_factor_16u", depth_factor_16u_, 1000.0);
     double max_interval = 0.05;
     pnh.param("sync_max_interval", max_interval, 0.05);
@@ -70,7 +68,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
     pub_ = nh.advertise<KeypointFrame>("yolo_slam/keypoint_frame", queue_size);
     diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
-    info_sub_ = nh.subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
+    // Multi-threaded handle: camera_info is stored even while a frame is being processed.
+    info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
     rgb_sub_.subscribe(nh, "camera/rgb/image_color", queue_size);
     depth_sub_.subscribe(nh, "camera/depth/image", queue_size);
     rgb_sub_.registerCallback(&ScreeningNodelet::onRgbArrived, this);
@@ -95,7 +94,6 @@ class ScreeningNodelet : public nodelet::Nodelet {
       CameraModel cam = cameraFromInfo(*info, base_cam_, info_sub_.getTopic());
       std::lock_guard<std::mutex> lock(cam_mutex_);
       cam_ = cam;
-      cam_cv_.notify_all();
     } catch (const std::exception& e) {
       NODELET_ERROR_THROTTLE(5.0, "Screening: %s", e.what());
     }
@@ -119,10 +117,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   CameraModel camera() {
     if (!use_camera_info_) return base_cam_;
-    std::unique_lock<std::mutex> lock(cam_mutex_);
-    // The first images can overtake their camera_info on another callback thread.
-    cam_cv_.wait_for(lock, std::chrono::duration<double>(camera_info_wait_),
-                     [this] { return cam_.has_value(); });
+    std::lock_guard<std::mutex> lock(cam_mutex_);
     if (!cam_)
       throw Error("no camera_info received on " + info_sub_.getTopic() +
                   "; publish the camera's CameraInfo or set ~use_camera_info false to take "
@@ -180,8 +175,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
       if (ms_.size() > 1000) ms_.erase(ms_.begin(), ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
-      NODELET_ERROR_THROTTLE(1.0, "Screening: frame %.3f rejected: %s",
-                             rgb->header.stamp.toSec(), e.what());
+      if (throttle_.shouldLog(e.what()))
+        NODELET_ERROR("Screening: frame %.3f rejected: %s", rgb->header.stamp.toSec(), e.what());
     }
   }
 
@@ -223,13 +218,13 @@ class ScreeningNodelet : public nodelet::Nodelet {
   }
 
   bool use_boxes_ = true, use_camera_info_ = true;
-  double camera_info_wait_ = 1.0, depth_factor_16u_ = 1000.0;
+  ErrorThrottle throttle_;
+  double depth_factor_16u_ = 1000.0;
   CameraModel base_cam_;
   std::unique_ptr<features::OrbExtractor> orb_;    // const after onInit (thread-safe extract)
   std::unique_ptr<screening::Screener> screener_;  // const after onInit (screen() is const)
 
   std::mutex cam_mutex_;  // guards cam_ (camera_info callback vs frame callback)
-  std::condition_variable cam_cv_;
   std::optional<CameraModel> cam_;
 
   std::mutex stats_mutex_;  // guards the counters below, pending_rgb_ and ms_

@@ -23,7 +23,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <atomic>
-#include <condition_variable>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -92,7 +91,6 @@ class SlamNodelet : public nodelet::Nodelet {
     int queue_size = 100;
     pnh.param("queue_size", queue_size, 100);
     pnh.param("use_camera_info", use_camera_info_, true);
-    pnh.param("camera_info_wait", camera_info_wait_, 1.0);
     pnh.param<std::string>("map_frame", map_frame_, "map");
     pnh.param<std::string>("odom_frame", odom_frame_, "odom");
     pnh.param<std::string>("base_frame", base_frame_, "base_link");
@@ -131,7 +129,8 @@ class SlamNodelet : public nodelet::Nodelet {
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
     debug_pub_ = nh.advertise<sensor_msgs::Image>("yolo_slam/debug_image", 2);
     diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
-    info_sub_ = nh.subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
+    // Multi-threaded handle: camera_info is stored even while a frame is being processed.
+    info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
     if (debug_image_)
       rgb_sub_ = nh.subscribe("camera/rgb/image_color", 30, &SlamNodelet::onRgb, this);
     frame_sub_ = nh.subscribe("yolo_slam/keypoint_frame", queue_size, &SlamNodelet::onFrame, this,
@@ -162,7 +161,6 @@ class SlamNodelet : public nodelet::Nodelet {
       CameraModel cam = cameraFromInfo(*info, base_cam_, info_sub_.getTopic());
       std::lock_guard<std::mutex> lock(cam_mutex_);
       cam_ = cam;
-      cam_cv_.notify_all();
     } catch (const std::exception& e) {
       NODELET_ERROR_THROTTLE(5.0, "Slam: %s", e.what());
     }
@@ -176,9 +174,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
   CameraModel camera() {
     if (!use_camera_info_) return base_cam_;
-    std::unique_lock<std::mutex> lock(cam_mutex_);
-    cam_cv_.wait_for(lock, std::chrono::duration<double>(camera_info_wait_),
-                     [this] { return cam_.has_value(); });
+    std::lock_guard<std::mutex> lock(cam_mutex_);
     if (!cam_)
       throw Error("no camera_info received on " + info_sub_.getTopic() +
                   "; publish the camera's CameraInfo or set ~use_camera_info false to take "
@@ -217,8 +213,8 @@ class SlamNodelet : public nodelet::Nodelet {
       if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
-      NODELET_ERROR_THROTTLE(1.0, "Slam: frame %.3f rejected: %s", msg->header.stamp.toSec(),
-                             e.what());
+      if (throttle_.shouldLog(e.what()))
+        NODELET_ERROR("Slam: frame %.3f rejected: %s", msg->header.stamp.toSec(), e.what());
       return;
     }
     last_state_ = res.state;
@@ -520,8 +516,9 @@ class SlamNodelet : public nodelet::Nodelet {
 
   // Parameters (const after onInit).
   bool use_camera_info_ = true, publish_tf_ = true, publish_odom_tf_ = true;
+  ErrorThrottle throttle_;
   bool map_to_camera_ = false, debug_image_ = true;
-  double camera_info_wait_ = 1.0, map_period_ = 1.0;
+  double map_period_ = 1.0;
   std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_;
   Pose T_bc_ = Pose::Identity();  // camera pose in base_link
   Config settings_;
@@ -529,7 +526,6 @@ class SlamNodelet : public nodelet::Nodelet {
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
   std::mutex cam_mutex_;  // guards cam_ (camera_info callback vs frame callback)
-  std::condition_variable cam_cv_;
   std::optional<CameraModel> cam_;
 
   // Guards system_, localization_only_ and track_ms_ (frame callback, map timer, services,

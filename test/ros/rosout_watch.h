@@ -1,5 +1,5 @@
 #pragma once
-// Test helper: collects /rosout_agg so a test can assert that a nodelet logged a clear error.
+// Test helper: collects /rosout (the nodes publish there directly; no rosout node needed) so a test can assert that a nodelet logged a clear error.
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 
@@ -10,7 +10,7 @@
 class RosoutWatch {
  public:
   explicit RosoutWatch(ros::NodeHandle& nh)
-      : sub_(nh.subscribe("/rosout_agg", 1000, &RosoutWatch::onLog, this)) {}
+      : sub_(nh.subscribe("/rosout", 1000, &RosoutWatch::onLog, this)) {}
 
   // Number of messages at `level` (rosgraph_msgs::Log::ERROR, ...) whose text contains `needle`.
   size_t count(uint8_t level, const std::string& needle) const {

@@ -24,6 +24,8 @@
 #include <thread>
 #include <unistd.h>
 
+#include "yolo_slam/BoundingBoxes.h"
+#include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/SaveTrajectory.h"
 #include "yolo_slam/eval/ate.h"
 #include "yolo_slam/io/trajectory.h"
@@ -95,32 +97,32 @@ TEST(FullGraph, SyntheticWalkingBag) {
   ASSERT_EQ(run("/usr/bin/python3 " + script + " " + seq + " " + bag + " > " + dir + "/bag.log 2>&1"), 0);
 
   ros::Subscriber pose_sub = nh.subscribe<geometry_msgs::PoseStamped>(
-      "/yolo_slam/pose", 1000, [](const geometry_msgs::PoseStamped::ConstPtr&) {
+      "/yolo_slam/pose", 1000, +[](const geometry_msgs::PoseStamped::ConstPtr&) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_pose_wall.push_back(ros::WallTime::now().toSec());
       });
   ros::Subscriber path_sub = nh.subscribe<nav_msgs::Path>(
-      "/yolo_slam/path", 10, [](const nav_msgs::Path::ConstPtr& m) {
+      "/yolo_slam/path", 10, +[](const nav_msgs::Path::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_path_len = m->poses.size();
       });
   ros::Subscriber cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
-      "/yolo_slam/map_points", 10, [](const sensor_msgs::PointCloud2::ConstPtr& m) {
+      "/yolo_slam/map_points", 10, +[](const sensor_msgs::PointCloud2::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_cloud_points = static_cast<size_t>(m->width) * m->height;
       });
   ros::Subscriber marker_sub = nh.subscribe<visualization_msgs::MarkerArray>(
-      "/yolo_slam/keyframes", 10, [](const visualization_msgs::MarkerArray::ConstPtr& m) {
+      "/yolo_slam/keyframes", 10, +[](const visualization_msgs::MarkerArray::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_markers = m->markers.empty() ? 0 : m->markers[0].points.size() / 16;
       });
   ros::Subscriber debug_sub = nh.subscribe<sensor_msgs::Image>(
-      "/yolo_slam/debug_image", 10, [](const sensor_msgs::Image::ConstPtr&) {
+      "/yolo_slam/debug_image", 10, +[](const sensor_msgs::Image::ConstPtr&) {
         std::lock_guard<std::mutex> lock(g_mutex);
         ++g_debug_images;
       });
   ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 100, [](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+      "/diagnostics", 100, +[](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(g_mutex);
         for (const auto& s : m->status)
           for (const auto& kv : s.values) g_diag[s.name][kv.key] = kv.value;
@@ -139,12 +141,20 @@ TEST(FullGraph, SyntheticWalkingBag) {
     ros::WallDuration(8.0).sleep();  // rviz start-up under software OpenGL
   }
 
-  // Wait for the graph to subscribe, then play at rate 1 (the ground-truth tf moved aside).
-  ros::Publisher probe = nh.advertise<sensor_msgs::Image>("/camera/rgb/image_color", 1);
-  const ros::WallTime ready_end = ros::WallTime::now() + ros::WallDuration(30.0);
-  while (ros::WallTime::now() < ready_end && probe.getNumSubscribers() < 3) ros::WallDuration(0.1).sleep();
-  ASSERT_GE(probe.getNumSubscribers(), 3u) << "Detector, Screening and Slam should subscribe the colour images";
-  probe.shutdown();
+  // Wait until every nodelet is up (each one's output topic or service exists; they share one
+  // manager process, so input connections do not tell them apart), then play at rate 1 with
+  // the ground-truth tf moved aside.
+  ros::Subscriber boxes_probe = nh.subscribe("/yolo_slam/boxes", 1, +[](const yolo_slam::BoundingBoxes::ConstPtr&) {});
+  ros::Subscriber frames_probe = nh.subscribe("/yolo_slam/keypoint_frame", 1, +[](const yolo_slam::KeypointFrame::ConstPtr&) {});
+  const ros::WallTime ready_end = ros::WallTime::now() + ros::WallDuration(60.0);
+  auto ready = [&] {
+    return boxes_probe.getNumPublishers() > 0 && frames_probe.getNumPublishers() > 0 &&
+           ros::service::exists("/yolo_slam/save_trajectory", false);
+  };
+  while (ros::WallTime::now() < ready_end && !ready()) ros::WallDuration(0.1).sleep();
+  ASSERT_TRUE(ready()) << "Detector, Screening or Slam nodelet did not come up";
+  boxes_probe.shutdown();
+  frames_probe.shutdown();
   const ros::WallTime play_start = ros::WallTime::now();
   ASSERT_EQ(run("rosbag play --quiet --rate 1 --delay 1 " + bag + " /tf:=/tf_groundtruth"), 0);
   const double play_s = (ros::WallTime::now() - play_start).toSec();
@@ -181,7 +191,9 @@ TEST(FullGraph, SyntheticWalkingBag) {
     EXPECT_GE(static_cast<long>(g_path_len), tracked - 1);
     EXPECT_GT(g_cloud_points, 100u);
     EXPECT_GE(g_markers, 1u);
-    if (rviz) EXPECT_GT(g_debug_images, 0u);
+    if (rviz) {
+      EXPECT_GT(g_debug_images, 0u);
+    }
     if (g_pose_wall.size() > 1)
       std::printf("[full_graph] output rate %.1f poses/s (%zu poses over %.2f s wall)\n",
                   (g_pose_wall.size() - 1) / (g_pose_wall.back() - g_pose_wall.front()),

@@ -12,7 +12,7 @@ std::vector<std::string> g_reports;
 TEST(ZeroCopy, SinkReceivesThePublishedObject) {
   ros::NodeHandle nh;
   ros::Subscriber sub = nh.subscribe<std_msgs::String>(
-      "yolo_slam/zero_copy_report", 100, [](const std_msgs::String::ConstPtr& m) {
+      "yolo_slam/zero_copy_report", 100, +[](const std_msgs::String::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_reports.push_back(m->data);
       });
