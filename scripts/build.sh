@@ -6,12 +6,16 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
-mkdir -p "$YS_WS/src"
-if [ ! -e "$YS_WS/src/yolo_slam" ]; then
-  ln -s ../../.. "$YS_WS/src/yolo_slam"
-fi
-[ -e "$YS_WS/src/CMakeLists.txt" ] || ln -s /usr/share/catkin/cmake/toplevel.cmake "$YS_WS/src/CMakeLists.txt"
+# The workspace's source space is the hidden folder build/ws/.src holding a link to the
+# repository. Hidden, because roslaunch/rostest look files up by walking the package folder
+# with symlinks followed and skip only dot-folders: a visible build/ws/src/yolo_slam -> repo
+# link would make that walk loop forever.
+mkdir -p "$YS_WS/.src"
+[ -e "$YS_WS/.src/yolo_slam" ] || ln -s ../../.. "$YS_WS/.src/yolo_slam"
+[ -e "$YS_WS/.src/CMakeLists.txt" ] || ln -s /usr/share/catkin/cmake/toplevel.cmake "$YS_WS/.src/CMakeLists.txt"
+# A workspace configured with the older visible src/ layout is rebuilt from scratch.
+if [ -e "$YS_WS/src" ]; then rm -rf "$YS_WS/src" "$YS_WS/build" "$YS_WS/devel"; fi
 
 cd "$YS_WS"
-catkin_make -j2 -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
+catkin_make --source .src -j2 -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@"

@@ -7,7 +7,7 @@ PACKAGES=(
   # build tools and the ROS 1 stack as Debian 12 ships it (see docs in ../shared/docs/ros-on-debian.md)
   build-essential cmake pkg-config git
   ros-base-dev libtf2-ros-dev libcv-bridge-dev libimage-transport-dev python3-rostest rosbash
-  tf2-tools tf-tools libtf-dev rviz
+  tf2-tools tf-tools libtf-dev rviz libdiagnostic-msgs-dev libros-rosgraph-msgs-dev
   libopencv-dev libeigen3-dev libceres-dev libopenni2-dev libgtest-dev
   python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-geometry-msgs
   python3-std-srvs python3-rosbag python3-tf2-ros

@@ -13,7 +13,7 @@ cd "$YS_WS"
 rm -rf build/test_results
 set +u; source devel/setup.bash; set -u
 # One test at a time: the rostests each start a master, and the machine has two cores.
-catkin_make -j1 run_tests -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
+catkin_make --source .src -j1 run_tests -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 > build/run_tests.log 2>&1
 grep -E "^\[ *(RUN|  OK|  FAILED|  PASSED) |FAILURE|Failure|error:" build/run_tests.log | grep -v "^\[ RUN" | tail -200 || true
 
