@@ -106,6 +106,10 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     stats_.keypoints_kept += ss.kept;
     stats_.keypoints_dropped += ss.dropped;
   }
+  {
+    std::lock_guard<std::mutex> lk(last_frame_mutex_);
+    last_frame_ = ff;
+  }
   return trackFeatures(ff);
 }
 
@@ -183,6 +187,11 @@ TrackingState System::state() const {
 }
 
 void System::waitForLocalMapping() { mapper_->waitIdle(); }
+
+features::FeatureFrame System::lastFrame() const {
+  std::lock_guard<std::mutex> lk(last_frame_mutex_);
+  return last_frame_;
+}
 
 void System::recordDetectionTime(double ms) {
   std::lock_guard<std::mutex> lk(stats_mutex_);

@@ -95,6 +95,9 @@ class System {
   const features::OrbExtractor& extractor() const;
   const screening::Screener& screener() const;
   TrackingState state() const;
+  // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
+  // screener), e.g. for screening metrics against ground truth; empty before the first frame.
+  features::FeatureFrame lastFrame() const;
 
  private:
   void resetInternal(bool keep_trajectory);
@@ -116,6 +119,9 @@ class System {
   SystemStats stats_;
   bool shut_down_ = false;
   std::atomic<bool> localization_only_{false};
+  // Guards last_frame_ (taken alone, never while holding another of the mutexes above).
+  mutable std::mutex last_frame_mutex_;
+  features::FeatureFrame last_frame_;
 };
 
 }  // namespace slam
