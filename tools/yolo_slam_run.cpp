@@ -39,25 +39,39 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
 
+const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
+
 const char* kUsage =
-    "usage: yolo_slam_run --sequence DIR --config YAML --out DIR [--max-frames N] [--realtime]\n"
+    "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
-    "                     [--vocabulary FILE] [--boxes-from-gt]\n"
+    "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
-    "OUT/stats.json. Ctrl-C stops at the next frame and still writes everything.\n"
+    "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
+    "kept / dropped). On a synthetic sequence (DIR/masks/, from yolo_slam_synth) stats.json also\n"
+    "gets screening_metrics: recall of the keypoints on people's masks and retention of the\n"
+    "static keypoints inside the boxes. Ctrl-C stops at the next frame and still writes\n"
+    "everything (exit code 130).\n"
+    "  --sequence DIR     the TUM RGB-D folder (required)\n"
+    "  --out DIR          output folder, created if missing (required)\n"
+    "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
+    "                     LocalMapping.*, Detector.*); default DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
-    "  --dynamic-mode M   override Screening.mode of the config\n"
+    "  --dynamic-mode M   override Screening.mode of the config: off, detect, geometry or\n"
+    "                     detect+geometry (the paper's method)\n"
     "  --model DIR        detector model (folder, .cfg or .onnx); default Detector.model\n"
-    "  --vocabulary FILE  ORB vocabulary (binary or ORBvoc.txt) for BoW matching\n"
+    "  --vocabulary FILE  ORB vocabulary (binary or ORBvoc.txt) for BoW matching; default the\n"
+    "                     package's vocab/yolo_slam_orb_k10_L4.vocab when it exists\n"
+    "  --no-vocabulary    run without BoW: no BoW matching, relocalisation or loop closing\n"
     "  --boxes-from-gt    person boxes from the sequence's boxes.txt (synthetic ground truth)\n"
-    "                     instead of running the detector\n";
+    "                     instead of running the detector\n"
+    "  -h, --help         this text\n";
 
 struct Args {
   std::string sequence, config, out, model, vocabulary, dynamic_mode;
   long max_frames = -1;
-  bool realtime = false, boxes_from_gt = false;
+  bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false;
 };
 
 Args parseArgs(int argc, char** argv) {
@@ -72,7 +86,8 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--config") a.config = need(i, s);
     else if (s == "--out") a.out = need(i, s);
     else if (s == "--model") a.model = need(i, s);
-    else if (s == "--vocabulary") a.vocabulary = need(i, s);
+    else if (s == "--vocabulary") a.vocabulary = need(i, s), a.vocabulary_given = true;
+    else if (s == "--no-vocabulary") a.no_vocabulary = true;
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
     else if (s == "--realtime") a.realtime = true;
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
@@ -88,8 +103,23 @@ Args parseArgs(int argc, char** argv) {
       throw Error("unknown option '" + s + "'; see --help");
     }
   }
-  if (a.sequence.empty() || a.config.empty() || a.out.empty())
-    throw Error(std::string("--sequence, --config and --out are required\n") + kUsage);
+  if (a.sequence.empty() || a.out.empty())
+    throw Error(std::string("--sequence and --out are required\n") + kUsage);
+  if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
+  if (a.config.empty()) {
+    // yolo_slam_synth writes camera.yaml beside the images; real TUM folders need --config.
+    a.config = joinPath(a.sequence, "camera.yaml");
+    if (!fileExists(a.config))
+      throw Error(a.config + ": not found; pass the settings file with --config YAML (e.g. config/TUM3.yaml for TUM freiburg3)");
+  }
+  if (a.vocabulary_given) {
+    if (!fileExists(a.vocabulary))
+      throw Error(a.vocabulary + ": vocabulary file not found; fix the path or run without BoW (--no-vocabulary)");
+  } else if (!a.no_vocabulary) {
+    // Like ORB-SLAM2 loading ORBvoc.txt: BoW is on unless asked otherwise.
+    const std::string shipped = joinPath(packageDir(), kVocabName);
+    if (fileExists(shipped)) a.vocabulary = shipped;
+  }
   return a;
 }
 
@@ -125,6 +155,32 @@ struct Prepared {
   bool has_image = false;
   std::string warning;
   double detection_ms = -1;
+  cv::Mat mask;  // ground-truth dynamic mask (synthetic sequences), empty if none
+  std::string mask_path;
+};
+
+std::string baseName(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// Screening quality summed over the frames that have a ground-truth mask.
+struct MetricsAccumulator {
+  screening::ScreeningMetrics sum;
+  size_t frames = 0;
+
+  std::string json() const {
+    if (frames == 0) return "null";
+    std::ostringstream os;
+    os << "{\"frames\": " << frames << ", \"dynamic_keypoints\": " << sum.dynamic_total
+       << ", \"dropped\": " << sum.dynamic_dropped << ", \"dynamic_recall\": " << jsonNumber(sum.dynamicRecall(), 4)
+       << ", \"static_in_boxes\": " << sum.static_in_boxes << ", \"kept\": " << sum.static_in_boxes_kept
+       << ", \"static_retention\": " << jsonNumber(sum.staticRetention(), 4)
+       << ", \"static_keypoints\": " << sum.static_total << ", \"static_dropped\": " << sum.static_dropped
+       << ", \"static_drop_rate\": "
+       << jsonNumber(sum.static_total ? static_cast<double>(sum.static_dropped) / sum.static_total : 0.0, 4) << "}";
+    return os.str();
+  }
 };
 
 void makeDirs(const std::string& dir) {
@@ -173,13 +229,18 @@ int run(const Args& args) {
   std::shared_ptr<const vocabulary::Vocabulary> voc;
   if (!args.vocabulary.empty()) voc = vocabulary::Vocabulary::load(args.vocabulary);
   makeDirs(args.out);
-
-  std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s\n", n,
-               args.sequence.c_str(), screening::toString(mode).c_str(), detector_name.c_str());
+  // Synthetic sequences carry per-frame masks (masks/<rgb file name>): screening metrics.
+  const std::string mask_dir = joinPath(args.sequence, "masks");
+  const bool has_masks = dirExists(mask_dir);
 
   slam::System system(cam, sys_opt, voc);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  // Printed once the handlers are in place (the Ctrl-C test waits for this line).
+  std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s, vocabulary: %s%s\n", n,
+               args.sequence.c_str(), screening::toString(mode).c_str(), detector_name.c_str(),
+               args.vocabulary.empty() ? "none (no BoW)" : args.vocabulary.c_str(),
+               has_masks ? ", screening metrics from masks/" : "");
 
   // Worker: loads frame i and detects people in it (the detector is used by one task at a time).
   auto prepare = [&](size_t i) {
@@ -213,12 +274,24 @@ int run(const Args& args) {
         if (it != gt_boxes.end()) p.boxes = it->second;
       }
     }
+    if (has_masks) {
+      // A frame without a mask is simply not evaluated; an unreadable one is reported.
+      p.mask_path = joinPath(mask_dir, baseName(seq.frames()[i].rgb_path));
+      if (fileExists(p.mask_path)) {
+        try {
+          p.mask = screening::loadMask(p.mask_path);
+        } catch (const std::exception& e) {
+          p.warning += (p.warning.empty() ? "" : "; ") + std::string(e.what()) + " (frame not evaluated)";
+        }
+      }
+    }
     return p;
   };
 
   ProgressBar bar("yolo_slam_run", n);
   std::vector<double> frame_ms;
   size_t skipped = 0, processed = 0, lost_reports = 0;
+  MetricsAccumulator metrics;
   Stopwatch total;
   const auto wall0 = std::chrono::steady_clock::now();
   const double stamp0 = n ? seq.frames()[0].rgb_stamp : 0;
@@ -241,6 +314,16 @@ int run(const Args& args) {
       slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
       if (r.state != slam::TrackingState::Ok) ++lost_reports;
       ++processed;
+      if (!p.mask.empty()) {
+        // Retention counts static keypoints inside the boxes this run used (none in modes
+        // off/geometry); exact synthetic masks need no ignored border.
+        try {
+          metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, p.boxes, 0);
+          ++metrics.frames;
+        } catch (const Error& e) {
+          std::fprintf(stderr, "\nwarning: %s: %s (frame not evaluated)\n", p.mask_path.c_str(), e.what());
+        }
+      }
     }
     frame_ms.push_back(fsw.ms());
     char extra[96];
@@ -284,7 +367,9 @@ int run(const Args& args) {
      << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
      << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 2)
      << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-     << ", \"dropped\": " << s.keypoints_dropped << "}";
+     << ", \"dropped\": " << s.keypoints_dropped << "}"
+     << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
+     << ",\n  \"screening_metrics\": " << metrics.json();
   std::vector<double> et;
   for (size_t k = 0; k < s.tracking_ms.size() && k < s.extraction_ms.size(); ++k)
     et.push_back(s.extraction_ms[k] + s.tracking_ms[k]);
@@ -308,6 +393,13 @@ int run(const Args& args) {
   std::printf("extraction+tracking median %.2f ms, p95 %.2f ms; %.1f frames/s overall\n", t.median, t.p95,
               total_s > 0 ? (processed + skipped) / total_s : 0.0);
   if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);
+  if (metrics.frames > 0)
+    std::printf("screening: dynamic recall %.1f%% (%d of %d), static retention in boxes %.1f%% (%d of %d), "
+                "static dropped %.2f%% over %zu frames\n",
+                100 * metrics.sum.dynamicRecall(), metrics.sum.dynamic_dropped, metrics.sum.dynamic_total,
+                100 * metrics.sum.staticRetention(), metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes,
+                metrics.sum.static_total ? 100.0 * metrics.sum.static_dropped / metrics.sum.static_total : 0.0,
+                metrics.frames);
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;
 }
