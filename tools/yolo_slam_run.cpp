@@ -164,6 +164,16 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// num/den as JSON; null without a denominator (e.g. no box in modes off/geometry).
+std::string jsonRatio(long num, long den) { return den > 0 ? jsonNumber(static_cast<double>(num) / den, 4) : "null"; }
+
+std::string percent(long num, long den) {
+  if (den <= 0) return "n/a (none)";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.1f%% (%ld of %ld)", 100.0 * num / den, num, den);
+  return buf;
+}
+
 // Screening quality summed over the frames that have a ground-truth mask.
 struct MetricsAccumulator {
   screening::ScreeningMetrics sum;
@@ -173,12 +183,12 @@ struct MetricsAccumulator {
     if (frames == 0) return "null";
     std::ostringstream os;
     os << "{\"frames\": " << frames << ", \"dynamic_keypoints\": " << sum.dynamic_total
-       << ", \"dropped\": " << sum.dynamic_dropped << ", \"dynamic_recall\": " << jsonNumber(sum.dynamicRecall(), 4)
+       << ", \"dropped\": " << sum.dynamic_dropped
+       << ", \"dynamic_recall\": " << jsonRatio(sum.dynamic_dropped, sum.dynamic_total)
        << ", \"static_in_boxes\": " << sum.static_in_boxes << ", \"kept\": " << sum.static_in_boxes_kept
-       << ", \"static_retention\": " << jsonNumber(sum.staticRetention(), 4)
+       << ", \"static_retention\": " << jsonRatio(sum.static_in_boxes_kept, sum.static_in_boxes)
        << ", \"static_keypoints\": " << sum.static_total << ", \"static_dropped\": " << sum.static_dropped
-       << ", \"static_drop_rate\": "
-       << jsonNumber(sum.static_total ? static_cast<double>(sum.static_dropped) / sum.static_total : 0.0, 4) << "}";
+       << ", \"static_drop_rate\": " << jsonRatio(sum.static_dropped, sum.static_total) << "}";
     return os.str();
   }
 };
@@ -394,12 +404,11 @@ int run(const Args& args) {
               total_s > 0 ? (processed + skipped) / total_s : 0.0);
   if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);
   if (metrics.frames > 0)
-    std::printf("screening: dynamic recall %.1f%% (%d of %d), static retention in boxes %.1f%% (%d of %d), "
-                "static dropped %.2f%% over %zu frames\n",
-                100 * metrics.sum.dynamicRecall(), metrics.sum.dynamic_dropped, metrics.sum.dynamic_total,
-                100 * metrics.sum.staticRetention(), metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes,
-                metrics.sum.static_total ? 100.0 * metrics.sum.static_dropped / metrics.sum.static_total : 0.0,
-                metrics.frames);
+    std::printf("screening vs masks over %zu frames: dynamic recall %s, static retention in boxes %s, "
+                "static dropped %s\n",
+                metrics.frames, percent(metrics.sum.dynamic_dropped, metrics.sum.dynamic_total).c_str(),
+                percent(metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes).c_str(),
+                percent(metrics.sum.static_dropped, metrics.sum.static_total).c_str());
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;
 }

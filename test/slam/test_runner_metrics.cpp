@@ -191,6 +191,9 @@ TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   EXPECT_EQ(jsonNumberOf(m, "dropped"), 0) << m;
   EXPECT_EQ(jsonNumberOf(m, "dynamic_recall"), 0) << m;
   EXPECT_EQ(jsonNumberOf(m, "static_dropped"), 0) << m;
+  // No box in mode off: retention has no denominator.
+  EXPECT_EQ(jsonNumberOf(m, "static_in_boxes"), 0) << m;
+  EXPECT_NE(m.find("\"static_retention\": null"), std::string::npos) << m;
 }
 
 TEST_F(RunnerMetrics, CorruptMaskWarnsMissingMaskIsSkipped) {
