@@ -3,6 +3,7 @@
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/optimization/bundle_adjustment.h"
 #include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/loop_closing.h"
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
@@ -69,7 +70,21 @@ void LocalMapping::pause() {
 void LocalMapping::waitUntilPaused() {
   std::unique_lock<std::mutex> lk(queue_mutex_);
   if (!thread_.joinable()) return;
-  cv_.wait(lk, [this] { return paused_ack_ || stop_ || !pause_requested_.load(); });
+  cv_.wait(lk, [this] { return paused_ack_ || stop_ || !pauseWanted(); });
+}
+
+void LocalMapping::pauseForLoop() {
+  loop_pause_.store(true);
+  abort_ba_.store(true);
+  cv_.notify_all();
+}
+
+void LocalMapping::resumeFromLoop() {
+  {
+    std::lock_guard<std::mutex> lk(queue_mutex_);
+    loop_pause_.store(false);
+  }
+  cv_.notify_all();
 }
 
 void LocalMapping::resume() {
@@ -110,13 +125,13 @@ size_t LocalMapping::culledKeyFrames() const {
 void LocalMapping::run() {
   std::unique_lock<std::mutex> lk(queue_mutex_);
   while (true) {
-    cv_.wait(lk, [this] { return stop_ || pause_requested_.load() || !queue_.empty(); });
+    cv_.wait(lk, [this] { return stop_ || pauseWanted() || !queue_.empty(); });
     if (stop_) break;
-    if (pause_requested_.load()) {
+    if (pauseWanted()) {
       paused_ack_ = true;
       accept_.store(false);
       cv_.notify_all();
-      cv_.wait(lk, [this] { return stop_ || !pause_requested_.load(); });
+      cv_.wait(lk, [this] { return stop_ || !pauseWanted(); });
       paused_ack_ = false;
       accept_.store(queue_.empty());
       continue;
@@ -160,18 +175,19 @@ void LocalMapping::processOne(const KeyFramePtr& kf) {
     searchInNeighbors();
   }
   abort_ba_.store(false);
-  if (queueEmpty(queue_mutex_, queue_) && !pause_requested_.load()) {
+  if (queueEmpty(queue_mutex_, queue_) && !pauseWanted()) {
     if (opt_.local_ba) localBundleAdjustment();
     std::lock_guard<std::mutex> lk(map_.update_mutex);
     keyFrameCulling();
   }
+  if (loop_closer_) loop_closer_->insertKeyFrame(current_);  // it checks `bad` under the map lock
   current_.reset();
 }
 
 void LocalMapping::processNewKeyFrame() {
   KeyFrame& kf = *current_;
   if (voc_ && kf.f.bow.empty() && kf.f.N > 0)
-    voc_->transform(kf.f.descriptors, kf.f.bow.bow, kf.f.bow.features, 4);
+    voc_->transform(kf.f.descriptors, kf.f.bow.bow, kf.f.bow.features, kBowLevelsUp);
   for (size_t i = 0; i < kf.f.points.size(); ++i) {
     MapPointPtr mp = kf.f.points[i];
     if (!mp) continue;

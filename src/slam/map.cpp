@@ -1,5 +1,8 @@
 #include "yolo_slam/slam/map.h"
 
+#include "yolo_slam/vocabulary/keyframe_database.h"
+
+#include <algorithm>
 #include <limits>
 
 namespace yolo_slam {
@@ -11,6 +14,13 @@ void Map::addKeyFrame(const KeyFramePtr& kf) {
     kf->is_origin = true;
   }
   keyframes_.insert(kf);
+  if (kfdb_ && !kf->f.bow.empty()) kfdb_->add(kf->id, kf->f.bow.bow);
+}
+
+KeyFramePtr Map::keyFrame(long id) const {
+  auto it = std::lower_bound(keyframes_.begin(), keyframes_.end(), id,
+                             [](const KeyFramePtr& k, long v) { return k->id < v; });
+  return it != keyframes_.end() && (*it)->id == id ? *it : nullptr;
 }
 
 void Map::addMapPoint(const MapPointPtr& mp) { points_.insert(mp); }
@@ -120,6 +130,7 @@ void Map::eraseKeyFrame(const KeyFramePtr& kf) {
   kf->loop_edges.clear();
   kf->bad = true;
   keyframes_.erase(kf);
+  if (kfdb_) kfdb_->erase(kf->id);
 }
 
 std::vector<KeyFramePtr> Map::keyframes() const {
@@ -147,6 +158,7 @@ void Map::clear() {
   keyframes_.clear();
   points_.clear();
   origin_.reset();
+  if (kfdb_) kfdb_->clear();
 }
 
 }  // namespace slam

@@ -52,10 +52,29 @@ LocalMappingOptions LocalMappingOptions::load(const Config& cfg) {
   return o;
 }
 
+LoopClosingOptions LoopClosingOptions::load(const Config& cfg) {
+  LoopClosingOptions o;
+  o.enabled = cfg.getBool("LoopClosing.enabled", o.enabled);
+  o.min_score = rangeDouble(cfg, "LoopClosing.minScore", o.min_score, 0.0, 1.0);
+  o.consistency = positiveInt(cfg, "LoopClosing.consistency", o.consistency, 1);
+  o.min_keyframes = positiveInt(cfg, "LoopClosing.minKeyFrames", o.min_keyframes, 0);
+  o.min_bow_matches = positiveInt(cfg, "LoopClosing.minBowMatches", o.min_bow_matches, 6);
+  o.min_ransac_inliers = positiveInt(cfg, "LoopClosing.minRansacInliers", o.min_ransac_inliers, 6);
+  o.min_matches = positiveInt(cfg, "LoopClosing.minMatches", o.min_matches, 10);
+  o.max_correction_m = rangeDouble(cfg, "LoopClosing.maxCorrectionM", o.max_correction_m, 0.0, 1e6);
+  o.max_correction_deg = rangeDouble(cfg, "LoopClosing.maxCorrectionDeg", o.max_correction_deg, 0.0, 180.0);
+  o.covisibility_weight = positiveInt(cfg, "LoopClosing.covisibilityWeight", o.covisibility_weight, 15);
+  o.pose_graph_iterations = positiveInt(cfg, "LoopClosing.poseGraphIterations", o.pose_graph_iterations, 1);
+  o.global_ba = cfg.getBool("LoopClosing.globalBA", o.global_ba);
+  o.global_ba_iterations = positiveInt(cfg, "LoopClosing.globalBAIterations", o.global_ba_iterations, 1);
+  return o;
+}
+
 SlamOptions SlamOptions::load(const Config& cfg) {
   SlamOptions o;
   o.tracking = TrackingOptions::load(cfg);
   o.mapping = LocalMappingOptions::load(cfg);
+  o.loop = LoopClosingOptions::load(cfg);
   return o;
 }
 

@@ -9,9 +9,11 @@
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/local_mapping.h"
+#include "yolo_slam/slam/loop_closing.h"
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/tracking.h"
+#include "yolo_slam/vocabulary/keyframe_database.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -43,9 +45,18 @@ System::System(const CameraModel& cam, const SystemOptions& options,
   screener_ = std::make_unique<screening::Screener>(options.screening);
   auto pyr = std::make_shared<ScalePyramid>(ScalePyramid::make(orb_opt.n_levels, orb_opt.scale_factor));
   map_ = std::make_unique<Map>();
+  if (voc_) {
+    kfdb_ = std::make_unique<vocabulary::KeyFrameDatabase>();
+    map_->setKeyFrameDatabase(kfdb_.get());
+  }
   mapper_ = std::make_unique<LocalMapping>(*map_, cam_, opt_.mapping, voc_);
+  if (voc_ && opt_.loop.enabled) {
+    loop_closer_ = std::make_unique<LoopClosing>(*map_, cam_, opt_.loop, mapper_.get());
+    mapper_->setLoopClosing(loop_closer_.get());
+  }
   tracker_ = std::make_unique<Tracking>(cam_, opt_.tracking, *map_, mapper_.get(), voc_, pyr);
   mapper_->start();
+  if (loop_closer_) loop_closer_->start();
 }
 
 System::~System() { shutdown(); }
@@ -54,6 +65,8 @@ void System::shutdown() {
   std::lock_guard<std::mutex> lk(track_mutex_);
   if (shut_down_) return;
   shut_down_ = true;
+  // Loop closing first: a correction or global BA in progress pauses the mapper and needs it.
+  if (loop_closer_) loop_closer_->stop();
   mapper_->stop();
 }
 
@@ -141,7 +154,12 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
 }
 
 void System::resetInternal(bool keep_trajectory) {
-  // Caller holds track_mutex_. Local mapping must be parked before the map is cleared.
+  // Caller holds track_mutex_. Loop closing (and its global BA) is stopped and local mapping
+  // parked before the map is cleared.
+  if (loop_closer_) {
+    loop_closer_->stop();
+    loop_closer_->clear();
+  }
   mapper_->pause();
   mapper_->waitUntilPaused();
   mapper_->clear();
@@ -162,6 +180,7 @@ void System::resetInternal(bool keep_trajectory) {
     ++stats_.resets;
   }
   if (!localization_only_.load()) mapper_->resume();
+  if (loop_closer_) loop_closer_->start();
 }
 
 void System::reset() {
@@ -187,6 +206,17 @@ TrackingState System::state() const {
 }
 
 void System::waitForLocalMapping() { mapper_->waitIdle(); }
+
+void System::waitForLoopClosing() {
+  // Local mapping feeds loop closing, and a loop correction can hold up local mapping.
+  mapper_->waitIdle();
+  if (loop_closer_) loop_closer_->waitIdle();
+  mapper_->waitIdle();
+}
+
+std::vector<std::pair<long, long>> System::loops() const {
+  return loop_closer_ ? loop_closer_->loops() : std::vector<std::pair<long, long>>{};
+}
 
 features::FeatureFrame System::lastFrame() const {
   std::lock_guard<std::mutex> lk(last_frame_mutex_);
@@ -245,6 +275,13 @@ SystemStats System::stats() const {
   }
   std::vector<double> lm = mapper_->timings();
   size_t culled = mapper_->culledKeyFrames();
+  size_t relocs = 0;
+  {
+    std::lock_guard<std::mutex> tl(track_mutex_);
+    relocs = tracker_->relocalizations();
+  }
+  const size_t loops = loop_closer_ ? loop_closer_->loopsClosed() : 0;
+  const size_t gbas = loop_closer_ ? loop_closer_->globalBundleAdjustments() : 0;
   std::lock_guard<std::mutex> lk(stats_mutex_);
   size_t kf = s.keyframes, mp = s.map_points;
   s = stats_;
@@ -252,6 +289,9 @@ SystemStats System::stats() const {
   s.map_points = mp;
   s.local_mapping_ms = std::move(lm);
   s.keyframes_culled = culled;
+  s.relocalizations = relocs;
+  s.loops_closed = loops;
+  s.global_bas = gbas;
   return s;
 }
 
@@ -262,6 +302,8 @@ std::string System::statsJson() const {
     << ",\n  \"lost\": " << s.lost << ",\n  \"keyframes\": " << s.keyframes
     << ",\n  \"keyframes_culled\": " << s.keyframes_culled
     << ",\n  \"map_points\": " << s.map_points << ",\n  \"resets\": " << s.resets
+    << ",\n  \"relocalizations\": " << s.relocalizations << ",\n  \"loops_closed\": " << s.loops_closed
+    << ",\n  \"global_bundle_adjustments\": " << s.global_bas
     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
     << ", \"dropped\": " << s.keypoints_dropped << "}"
     << ",\n  \"timings\": {\n    \"extraction\": " << summaryJsonMs(summarize(s.extraction_ms))

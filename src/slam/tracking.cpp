@@ -6,7 +6,10 @@
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
+#include "yolo_slam/vocabulary/keyframe_database.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
+
+#include <opencv2/calib3d.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -41,7 +44,7 @@ Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map,
 
 void Tracking::computeBow(Frame& F) const {
   if (!voc_ || !F.bow.empty() || F.N == 0) return;
-  voc_->transform(F.descriptors, F.bow.bow, F.bow.features, 4);
+  voc_->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
 }
 
 TrackResult Tracking::track(const features::FeatureFrame& ff) {
@@ -107,10 +110,12 @@ TrackResult Tracking::track(const features::FeatureFrame& ff) {
   if (ok && !finitePose(F.T_cw)) ok = false;
 
   if (ok) {
+    const bool was_lost = state_ == TrackingState::Lost;
     failures_in_row_ = 0;
     lost_frames_in_row_ = 0;
     state_ = TrackingState::Ok;
-    if (has_last_) {
+    // After a lost stretch the last tracked frame is far in the past: no velocity from it.
+    if (has_last_ && !was_lost) {
       velocity_ = F.T_cw * last_.T_cw.inverse();
       has_velocity_ = finitePose(velocity_);
     }
@@ -319,8 +324,9 @@ bool Tracking::trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pos
 }
 
 bool Tracking::trackWhenLost(Frame& F) {
-  // No relocalisation yet: try the last reference keyframe and its covisible keyframes with
-  // the last good pose as prior.
+  // Place recognition over the whole map first (needs a vocabulary); then, for runs without
+  // one, the last reference keyframe and its covisibles with the last good pose as prior.
+  if (relocalize(F)) return true;
   if (!has_last_good_) return false;
   std::vector<KeyFramePtr> cands;
   KeyFramePtr ref = ref_kf_;
@@ -337,6 +343,137 @@ bool Tracking::trackWhenLost(Frame& F) {
       return true;
     }
   }
+  return false;
+}
+
+bool Tracking::relocalize(Frame& F) {
+  vocabulary::KeyFrameDatabase* db = map_.keyFrameDatabase();
+  if (!voc_ || !db || F.N == 0) return false;
+  computeBow(F);
+  if (F.bow.empty()) return false;
+
+  // Candidates (ORB-SLAM2 DetectRelocalizationCandidates): keyframes sharing enough words, then
+  // grouped with their 10 best covisibles; groups scoring > 0.75 x the best group survive, each
+  // represented by its best keyframe.
+  const auto hits = db->query(F.bow.bow, 0);
+  if (hits.empty()) return false;
+  std::map<long, double> score_of(hits.begin(), hits.end());
+  std::vector<std::pair<double, KeyFramePtr>> groups;
+  double best_acc = 0;
+  for (const auto& h : hits) {
+    KeyFramePtr kf = map_.keyFrame(h.first);
+    if (!kf || kf->bad) continue;
+    double acc = h.second, best_score = h.second;
+    KeyFramePtr best_kf = kf;
+    for (const auto& nb : kf->bestCovisibles(10)) {
+      auto it = score_of.find(nb->id);
+      if (it == score_of.end() || nb->bad) continue;
+      acc += it->second;
+      if (it->second > best_score) {
+        best_score = it->second;
+        best_kf = nb;
+      }
+    }
+    groups.emplace_back(acc, best_kf);
+    best_acc = std::max(best_acc, acc);
+  }
+  std::vector<KeyFramePtr> cands;
+  std::set<long> seen;
+  std::sort(groups.begin(), groups.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second->id < b.second->id); });
+  for (const auto& g : groups)
+    if (g.first > 0.75 * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
+  if (cands.size() > 20) cands.resize(20);
+
+  cv::Mat K = (cv::Mat_<double>(3, 3) << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1);
+  for (const KeyFramePtr& kf : cands) {
+    if (kf->f.bow.empty()) computeBow(kf->f);
+    std::fill(F.points.begin(), F.points.end(), nullptr);
+    std::fill(F.outlier.begin(), F.outlier.end(), false);
+    if (matcher::searchByBow(*kf, F, 0.75) < 15) continue;
+
+    // PnP RANSAC on the BoW matches (undistorted keypoints: no distortion coefficients).
+    std::vector<cv::Point3f> obj;
+    std::vector<cv::Point2f> img;
+    std::vector<int> idx;
+    for (int i = 0; i < F.N; ++i) {
+      const MapPointPtr& mp = F.points[i];
+      if (!mp || mp->bad) continue;
+      obj.emplace_back(static_cast<float>(mp->Xw.x()), static_cast<float>(mp->Xw.y()),
+                       static_cast<float>(mp->Xw.z()));
+      img.push_back(F.kps[i].pt);
+      idx.push_back(i);
+    }
+    if (obj.size() < 15) continue;
+    cv::Mat rvec, tvec;
+    std::vector<int> inl;
+    bool ok = false;
+    try {
+      ok = cv::solvePnPRansac(obj, img, K, cv::noArray(), rvec, tvec, false, 300, 5.991f, 0.99, inl,
+                              cv::SOLVEPNP_EPNP);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    if (!ok || inl.size() < 10) continue;
+    cv::Mat R;
+    cv::Rodrigues(rvec, R);
+    Pose T = Pose::Identity();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) T.linear()(r, c) = R.at<double>(r, c);
+      T.translation()(r) = tvec.at<double>(r);
+    }
+    if (!finitePose(T)) continue;
+    std::vector<bool> keep(F.N, false);
+    for (int k : inl) keep[idx[k]] = true;
+    for (int i = 0; i < F.N; ++i)
+      if (!keep[i]) F.points[i].reset();
+    F.setPose(T);
+
+    int good = optimizePose(F);
+    if (good < 10) continue;
+    for (int i = 0; i < F.N; ++i)
+      if (F.points[i] && F.outlier[i]) {
+        F.points[i].reset();
+        F.outlier[i] = false;
+      }
+    // Few inliers: look for more by projecting the candidate's points (ORB-SLAM2 window 10,
+    // then 3 with the refined pose).
+    auto project_kf = [&](double th) {
+      std::set<long> have;
+      for (const auto& mp : F.points)
+        if (mp) have.insert(mp->id);
+      std::vector<matcher::Projection> proj;
+      for (const auto& mp : kf->mapPoints()) {
+        if (mp->dynamic || have.count(mp->id)) continue;
+        matcher::Projection p;
+        if (matcher::projectInFrame(F, mp, 0.0, p)) proj.push_back(p);
+      }
+      return matcher::searchProjections(F, proj, th, 0.9);
+    };
+    if (good < 50) {
+      if (project_kf(10.0) + good >= 50) {
+        good = optimizePose(F);
+        if (good > 30 && good < 50) {
+          for (int i = 0; i < F.N; ++i)
+            if (F.points[i] && F.outlier[i]) F.points[i].reset();
+          if (project_kf(3.0) + good >= 50) good = optimizePose(F);
+        }
+      }
+    }
+    if (good < 50) continue;
+    for (int i = 0; i < F.N; ++i)
+      if (F.points[i] && F.outlier[i]) {
+        F.points[i].reset();
+        F.outlier[i] = false;
+      }
+    ref_kf_ = kf;
+    last_reloc_frame_id_ = F.id;
+    has_velocity_ = false;
+    ++relocalizations_;
+    return true;
+  }
+  std::fill(F.points.begin(), F.points.end(), nullptr);
+  std::fill(F.outlier.begin(), F.outlier.end(), false);
   return false;
 }
 
@@ -444,6 +581,9 @@ bool Tracking::trackLocalMap(Frame& F) {
 bool Tracking::needNewKeyFrame(const Frame& F) const {
   if (!mapper_ || mapper_->paused()) return false;
   const int n_kfs = static_cast<int>(map_.numKeyFrames());
+  // Right after a relocalisation the pose rests on few points: wait (ORB-SLAM2).
+  if (last_reloc_frame_id_ >= 0 && F.id < last_reloc_frame_id_ + max_frames_ && n_kfs > max_frames_)
+    return false;
   const int min_obs = n_kfs <= 2 ? 2 : 3;
   KeyFramePtr ref = ref_kf_;
   const int ref_matches = ref && !ref->bad ? ref->trackedMapPoints(min_obs) : 0;

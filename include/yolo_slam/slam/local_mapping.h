@@ -21,6 +21,8 @@ class Vocabulary;
 }
 namespace slam {
 
+class LoopClosing;
+
 class LocalMapping {
  public:
   LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
@@ -44,7 +46,13 @@ class LocalMapping {
   void pause();
   void waitUntilPaused();
   void resume();
-  bool paused() const { return pause_requested_.load(); }
+  // The same pause for loop closing, independent of the one above (a loop correction ending
+  // does not resume a mapper parked for localization-only mode or a reset).
+  void pauseForLoop();
+  void resumeFromLoop();
+  bool paused() const { return pauseWanted(); }
+  // Every processed keyframe is handed on (set before start(); may be null).
+  void setLoopClosing(LoopClosing* lc) { loop_closer_ = lc; }
   // Blocks until the queue is empty and the thread is idle (tests, deterministic runs).
   // The caller must NOT hold map.update_mutex.
   void waitIdle();
@@ -62,6 +70,7 @@ class LocalMapping {
 
  private:
   void run();
+  bool pauseWanted() const { return pause_requested_.load() || loop_pause_.load(); }
   void processNewKeyFrame();
   void mapPointCulling();
   void createNewMapPoints();
@@ -88,6 +97,8 @@ class LocalMapping {
   std::atomic<bool> accept_{true};
   std::atomic<bool> abort_ba_{false};
   std::atomic<bool> pause_requested_{false};
+  std::atomic<bool> loop_pause_{false};
+  LoopClosing* loop_closer_ = nullptr;
   std::thread thread_;
 
   // Mapping-thread state (only touched by the thread running processOne).

@@ -30,6 +30,9 @@
 #include <vector>
 
 namespace yolo_slam {
+namespace vocabulary {
+class KeyFrameDatabase;
+}
 namespace slam {
 
 class Map {
@@ -47,8 +50,15 @@ class Map {
   long newKeyFrameId() { return next_kf_id_++; }
   long newPointId() { return next_point_id_++; }
 
+  // Place-recognition index kept in step with the keyframe set: addKeyFrame adds a keyframe with
+  // a filled BoW slot, eraseKeyFrame and clear remove. Set once before use (System); may be null.
+  // The database has its own mutex, always taken after update_mutex (never the other way).
+  void setKeyFrameDatabase(vocabulary::KeyFrameDatabase* db) { kfdb_ = db; }
+  vocabulary::KeyFrameDatabase* keyFrameDatabase() const { return kfdb_; }
+
   // --- all below: caller holds update_mutex ---
   void addKeyFrame(const KeyFramePtr& kf);
+  KeyFramePtr keyFrame(long id) const;          // null if not (or no longer) in the map
   void addMapPoint(const MapPointPtr& mp);
   // Adds the observation both ways (kf->f.points[idx] = mp and mp->observations[kf] = idx).
   static void addObservation(const MapPointPtr& mp, const KeyFramePtr& kf, size_t idx);
@@ -76,6 +86,7 @@ class Map {
   std::set<KeyFramePtr, ById> keyframes_;
   std::set<MapPointPtr, ById> points_;
   KeyFramePtr origin_;
+  vocabulary::KeyFrameDatabase* kfdb_ = nullptr;
   std::atomic<long> next_kf_id_{0};
   std::atomic<long> next_point_id_{0};
 };

@@ -1,6 +1,6 @@
 #pragma once
-// Options of the SLAM core (tracking and local mapping), read from the Tracking.* and
-// LocalMapping.* keys. Defaults are ORB-SLAM2's constants for RGB-D.
+// Options of the SLAM core (tracking, local mapping, loop closing), read from the Tracking.*,
+// LocalMapping.* and LoopClosing.* keys. Defaults are ORB-SLAM2's constants for RGB-D.
 #include <string>
 
 namespace yolo_slam {
@@ -41,9 +41,30 @@ struct LocalMappingOptions {
   static LocalMappingOptions load(const Config& cfg);
 };
 
+// Loop closing (ORB-SLAM2 LoopClosing with SE3 instead of Sim3: RGB-D has metric scale).
+struct LoopClosingOptions {
+  bool enabled = true;               // LoopClosing.enabled (needs a vocabulary)
+  double min_score = 0.0;            // LoopClosing.minScore: floor of the BoW score; the bar is
+                                     // max(this, lowest score against the keyframe's covisibles)
+  int consistency = 3;               // LoopClosing.consistency: consecutive keyframes agreeing
+  int min_keyframes = 10;            // LoopClosing.minKeyFrames: map size / keyframes since last loop
+  int min_bow_matches = 20;          // LoopClosing.minBowMatches: SearchByBoW matches per candidate
+  int min_ransac_inliers = 20;       // LoopClosing.minRansacInliers: 3D-3D RANSAC inliers
+  int min_matches = 40;              // LoopClosing.minMatches: after the projection search
+  double max_correction_m = 0.5;     // LoopClosing.maxCorrectionM: larger pose corrections are
+  double max_correction_deg = 20.0;  // LoopClosing.maxCorrectionDeg: taken for perceptual aliasing
+  int covisibility_weight = 100;     // LoopClosing.covisibilityWeight: essential-graph covisibility edges
+  int pose_graph_iterations = 20;    // LoopClosing.poseGraphIterations
+  bool global_ba = true;             // LoopClosing.globalBA: full BA in its own thread after a loop
+  int global_ba_iterations = 10;     // LoopClosing.globalBAIterations
+
+  static LoopClosingOptions load(const Config& cfg);
+};
+
 struct SlamOptions {
   TrackingOptions tracking;
   LocalMappingOptions mapping;
+  LoopClosingOptions loop;
   static SlamOptions load(const Config& cfg);
 };
 

@@ -25,6 +25,7 @@ class Config;
 
 namespace vocabulary {
 class Vocabulary;
+class KeyFrameDatabase;
 }
 
 namespace slam {
@@ -32,6 +33,7 @@ namespace slam {
 class Map;
 class Tracking;
 class LocalMapping;
+class LoopClosing;
 
 struct MapSnapshot {
   std::vector<Eigen::Vector3d> points;                 // static map points only, world frame
@@ -43,6 +45,7 @@ struct MapSnapshot {
 struct SystemStats {
   size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0, resets = 0;
   size_t keyframes_culled = 0;
+  size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
 };
@@ -52,7 +55,7 @@ struct SystemStats {
 struct SystemOptions {
   features::OrbOptions orb;              // ORBextractor.*
   screening::ScreeningOptions screening; // Screening.*
-  SlamOptions slam;                      // Tracking.*, LocalMapping.*
+  SlamOptions slam;                      // Tracking.*, LocalMapping.*, LoopClosing.*
   static SystemOptions load(const Config& cfg);
 };
 
@@ -98,6 +101,10 @@ class System {
   // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
   // screener), e.g. for screening metrics against ground truth; empty before the first frame.
   features::FeatureFrame lastFrame() const;
+  // Blocks until loop closing has processed its queue and any global BA has finished.
+  void waitForLoopClosing();
+  // (current keyframe id, loop keyframe id) of each loop closed so far.
+  std::vector<std::pair<long, long>> loops() const;
 
  private:
   void resetInternal(bool keep_trajectory);
@@ -107,8 +114,11 @@ class System {
   std::unique_ptr<features::OrbExtractor> orb_;
   std::unique_ptr<screening::Screener> screener_;
   std::shared_ptr<const vocabulary::Vocabulary> voc_;
+  // Declared before map_: the map removes keyframes from it until destroyed.
+  std::unique_ptr<vocabulary::KeyFrameDatabase> kfdb_;
   std::unique_ptr<Map> map_;
   std::unique_ptr<LocalMapping> mapper_;
+  std::unique_ptr<LoopClosing> loop_closer_;   // null without vocabulary or when disabled
   std::unique_ptr<Tracking> tracker_;
 
   // Serialises the tracking entry points (trackRgbd/trackFeatures/reset/setLocalizationOnly)

@@ -56,6 +56,7 @@ class Tracking {
   size_t trackedFrames() const { return tracked_; }
   size_t lostFrames() const { return lost_; }
   size_t resets() const { return resets_; }
+  size_t relocalizations() const { return relocalizations_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -65,6 +66,9 @@ class Tracking {
   bool trackMotionModel(Frame& F);
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
   bool trackWhenLost(Frame& F);
+  // ORB-SLAM2 Relocalization: BoW candidates from the map's KeyFrameDatabase, SearchByBoW,
+  // PnP RANSAC, pose optimisation, projection search for more matches; needs >= 50 inliers.
+  bool relocalize(Frame& F);
   bool trackLocalMap(Frame& F);
   void updateLastFrame();
   void updateLocalMap(Frame& F);
@@ -111,7 +115,8 @@ class Tracking {
 
   std::vector<FrameRecord> records_;
   Trajectory frozen_keyframes_;
-  size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0;
+  long last_reloc_frame_id_ = -1;
+  size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0;
 };
 
 }  // namespace slam

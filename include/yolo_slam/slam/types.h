@@ -24,6 +24,11 @@ struct BowData {
   bool empty() const { return bow.empty(); }
 };
 
+// Vocabulary levels above the words at which FeatureVectors group features for SearchByBoW
+// (ORB-SLAM2 uses 4 on its 6-level vocabulary; the shipped k=10 L=4 one needs 2 for the same
+// node size: ~100 nodes).
+constexpr int kBowLevelsUp = 2;
+
 // Orders shared pointers by object id so that iteration order (and so every result) is
 // deterministic, not dependent on heap addresses.
 struct ById {

@@ -1,0 +1,112 @@
+#pragma once
+// Loop closing (own thread, owned by System): ORB-SLAM2's LoopClosing for RGB-D, with SE3 in
+// place of Sim3 (depth gives metric scale). LocalMapping hands over every processed keyframe;
+// the thread
+//   1. detects loop candidates with the map's KeyFrameDatabase (score above the lowest score of
+//      the keyframe's covisibles, covisible keyframes excluded, the candidate's covisibility
+//      group consistent over `consistency` consecutive keyframes),
+//   2. verifies them geometrically (SearchByBoW, 3D-3D RANSAC with Umeyama/Horn on the map
+//      points, pose-only refinement, projection search of the loop side's points: >= min_matches),
+//   3. corrects: pauses local mapping, moves the current keyframe's covisible neighbourhood and
+//      its points onto the loop side, fuses duplicated points, adds the loop edge, optimises
+//      the essential graph (spanning tree + loop edges + covisibility >= covisibility_weight),
+//   4. runs global bundle adjustment in a separate thread (aborted by a new loop, reset or
+//      shutdown) and writes it back, propagating to keyframes created meanwhile via the tree.
+//
+// LOCKING. Map::update_mutex guards every map object (map.h). This class takes it for the
+// detection, the verification and the whole correction, and for the GBA copy/write-back;
+// never while waiting for LocalMapping to pause (LocalMapping needs it to finish its step).
+// queue_mutex_ guards queue_, busy_, stop_, running_ and the counters; taken alone or after
+// update_mutex, never before it. The KeyFrameDatabase mutex is always taken last.
+// Order overall: Tracking's System::track_mutex_ > Map::update_mutex > LocalMapping queue
+// mutex / LoopClosing::queue_mutex_ > KeyFrameDatabase mutex.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/geometry.h"
+#include "yolo_slam/slam/options.h"
+#include "yolo_slam/slam/types.h"
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace yolo_slam {
+namespace slam {
+
+class LocalMapping;
+
+class LoopClosing {
+ public:
+  // `mapper` (may be null in tests) is paused during a correction.
+  LoopClosing(Map& map, const CameraModel& cam, const LoopClosingOptions& opt, LocalMapping* mapper);
+  ~LoopClosing();
+  LoopClosing(const LoopClosing&) = delete;
+  LoopClosing& operator=(const LoopClosing&) = delete;
+
+  void start();   // spawns the thread (idempotent)
+  // Stops the thread and any global BA (aborted, not written back); queued keyframes dropped.
+  void stop();
+  // Called by LocalMapping after a keyframe is processed (no map lock held).
+  void insertKeyFrame(const KeyFramePtr& kf);
+  // Blocks until the queue is empty, no keyframe is processed and no global BA runs.
+  void waitIdle();
+  // Forgets queued keyframes and the consistency groups (map reset; thread stopped).
+  void clear();
+
+  // One keyframe's detection + verification + correction, synchronous (the thread calls this;
+  // tests may call it with the thread not started). Returns true if a loop was closed.
+  bool processOne(const KeyFramePtr& kf);
+
+  size_t loopsClosed() const;
+  size_t globalBundleAdjustments() const;   // completed and written back
+  // (current keyframe id, loop keyframe id) of every closed loop.
+  std::vector<std::pair<long, long>> loops() const;
+
+ private:
+  struct ConsistentGroup {
+    std::vector<long> kfs;   // a candidate with its covisibles
+    int count = 0;
+  };
+  void run();
+  std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);   // caller holds update_mutex
+  bool computeSE3(const KeyFramePtr& kf, const std::vector<KeyFramePtr>& cands);  // idem
+  void correctLoop(const KeyFramePtr& kf);                         // takes update_mutex
+  void stopGlobalBA();
+  void runGlobalBA(long loop_kf_id);
+
+  Map& map_;
+  CameraModel cam_;
+  LoopClosingOptions opt_;
+  LocalMapping* mapper_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable cv_;
+  std::deque<KeyFramePtr> queue_;
+  bool busy_ = false;
+  bool stop_ = false;
+  bool running_ = false;   // start() .. stop()
+  size_t loops_closed_ = 0, gba_done_ = 0;
+  std::vector<std::pair<long, long>> loops_;
+  std::thread thread_;
+
+  // Global BA thread: started by the loop thread only, joined by it (before a new correction)
+  // or by stop(). gba_running_ is read by waitIdle.
+  std::thread gba_thread_;
+  std::atomic<bool> gba_stop_{false};
+  std::atomic<bool> gba_running_{false};
+
+  // Loop-thread state (only touched by the thread running processOne).
+  std::vector<ConsistentGroup> groups_;
+  long last_loop_kf_id_ = -1;
+  KeyFramePtr matched_kf_;
+  Pose T_cw_corrected_ = Pose::Identity();
+  std::vector<MapPointPtr> current_matches_;   // per keypoint of the current kf: loop-side point
+  std::vector<MapPointPtr> loop_points_;       // points of the loop keyframe and its covisibles
+};
+
+}  // namespace slam
+}  // namespace yolo_slam
