@@ -37,7 +37,12 @@ using namespace yolo_slam;
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-void onSignal(int) { g_stop = 1; }
+// First Ctrl-C: finish the frame and write the results; the handler then reverts to the default
+// so a second Ctrl-C quits at once (signal() is async-signal-safe).
+void onSignal(int sig) {
+  g_stop = 1;
+  std::signal(sig, SIG_DFL);
+}
 
 const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
 
@@ -50,8 +55,8 @@ const char* kUsage =
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
     "kept / dropped). On a synthetic sequence (DIR/masks/, from yolo_slam_synth) stats.json also\n"
     "gets screening_metrics: recall of the keypoints on people's masks and retention of the\n"
-    "static keypoints inside the boxes. Ctrl-C stops at the next frame and still writes\n"
-    "everything (exit code 130).\n"
+    "static keypoints inside the boxes. Ctrl-C (or SIGTERM) stops at the next frame and still\n"
+    "writes everything (exit code 130); a second Ctrl-C quits at once without writing.\n"
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
     "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
