@@ -76,7 +76,7 @@ log() { echo "[$(date +%H:%M:%S)] $*"; }
   echo "command: bench/ablation.sh --frames $frames --runs $runs --presets \"$presets\" --modes \"$modes\" --seed $seed"
   echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
   echo "commit: $(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$repo" diff --quiet HEAD -- src include tools 2>/dev/null || echo ' (+uncommitted changes in src/include/tools)')"
-  echo "bin: $bin"
+  echo "bin: $bin (yolo_slam_run built $(date -u -r "$bin/yolo_slam_run" +%Y-%m-%dT%H:%M:%SZ 2>/dev/null || echo '?'))"
   echo "load_before: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
   echo "cpus: $(nproc 2>/dev/null)"
 } > "$out/meta.txt.new"
