@@ -32,6 +32,7 @@ frames_arg=()
 
 echo "== 1/3 generating the synthetic sequence '$preset' into $seq"
 rm -rf "$seq"
+mkdir -p "$(dirname "$seq")"
 "$BIN/yolo_slam_synth" --preset "$preset" --seed 1 --out "$seq" "${frames_arg[@]}"
 
 echo "== 2/3 running YOLO-SLAM (--dynamic-mode $mode)"
