@@ -66,7 +66,13 @@ void System::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   // Loop closing first: a correction or global BA in progress pauses the mapper and needs it.
-  if (loop_closer_) loop_closer_->stop();
+  // As ORB-SLAM2's Shutdown, a pending loop and a running global BA are finished, not dropped
+  // (a loop closed at the end of a sequence is otherwise left with only the pose-graph result).
+  if (loop_closer_) {
+    mapper_->waitIdle();
+    loop_closer_->waitIdle();
+    loop_closer_->stop();
+  }
   mapper_->stop();
 }
 

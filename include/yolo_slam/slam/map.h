@@ -17,8 +17,11 @@
 // tree, flags, counters). Tracking holds it for the whole processing of a frame; LocalMapping
 // holds it for each step of a keyframe, but releases it while Ceres solves the local bundle
 // adjustment on a copy (BaProblem) and re-takes it to write the result back; System takes it for
-// snapshots/trajectories. There are no per-object mutexes, so there is no lock-order problem
-// inside the map; the only other mutexes (LocalMapping queue, System stats) are always taken
+// snapshots/trajectories. LoopClosing holds it for loop detection + verification, for the whole
+// correction (pose propagation, fusion, essential graph) and for the global-BA copy/write-back,
+// never while it waits for LocalMapping to pause (see loop_closing.h). There are no per-object
+// mutexes, so there is no lock-order problem inside the map; the only other mutexes
+// (LocalMapping/LoopClosing queues, System stats, the KeyFrameDatabase's) are always taken
 // AFTER update_mutex or alone, never the other way round.
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/map_point.h"

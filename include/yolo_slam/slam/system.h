@@ -82,7 +82,9 @@ class System {
   void reset();
   void setLocalizationOnly(bool on);
   bool localizationOnly() const;
-  void shutdown();  // stops and joins the mapping thread; idempotent
+  // Finishes queued keyframes, a pending loop correction and a running global BA, then stops
+  // and joins the mapping and loop-closing threads; idempotent.
+  void shutdown();
 
   Trajectory cameraTrajectory() const;    // every tracked frame, T_wc
   Trajectory keyframeTrajectory() const;  // keyframes (also those of maps dropped by a reset)
