@@ -1,5 +1,5 @@
 // Screening benchmark on the real TUM fr3_walking_xyz frame with its person mask (shared data):
-//   screening_bench [--reps N] [--detector] [--sweep] [--seeds S] [--border PX]
+//   screening_bench [--reps N] [--detector] [--sweep] [--variants] [--seeds S] [--border PX]
 //   screening_bench --sequence DIR [--stride N] [--detector]
 // --sequence: quality of several configurations over every N-th frame of a yolo_slam_synth
 // sequence (exact masks/, boxes from boxes.txt or from the detector).
@@ -7,7 +7,8 @@
 // repetitions) and the quality against the mask: dynamic recall (mask keypoints dropped) and
 // static retention (non-mask keypoints inside boxes kept). --sweep prints the nThre table of
 // docs/screening.md (interpretations of the paper's 0.43 and a threshold sweep), averaged over
-// S seeds. Boxes come from the mask's connected components, or from the YOLO detector with
+// S seeds; --variants prints only the table of beyond-paper configurations (nearest cluster,
+// no-depth rules, dilation) and exits. Boxes come from the mask's connected components, or from the YOLO detector with
 // --detector (default model, see detection/detector.h).
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
@@ -89,6 +90,59 @@ RealFrame loadRealFrame(bool use_detector) {
 struct Quality {
   double recall = 0, retention = 0, dropped = 0;
 };
+
+// Configurations compared on both the real frame and synthetic sequences (docs/screening.md,
+// "nearest cluster"). Defaults of ScreeningOptions apart from what each entry sets.
+struct NamedOptions {
+  std::string name;
+  ScreeningOptions o;
+};
+
+std::vector<NamedOptions> variantConfigs() {
+  using NDR = ScreeningOptions::NoDepthRule;
+  std::vector<NamedOptions> v;
+  auto add = [&](const std::string& name, ScreeningVariant var, double thr, NDR nd, double dil,
+                 bool depth_only, double frac = 0.3, double nd_radius = 20) {
+    ScreeningOptions o;
+    o.variant = var;
+    o.variance_threshold_m2 = thr;
+    o.no_depth = nd;
+    o.box_dilation = dil;
+    o.dilation_depth_only = depth_only;
+    o.cluster_min_fraction = frac;
+    o.no_depth_radius_px = nd_radius;
+    v.push_back({name, o});
+  };
+  add("paper 0.02 (old variant)", ScreeningVariant::Paper, 0.02, NDR::Dynamic, 0.05, false);
+  add("grow 0.02 dyn dil 0.05 (old default)", ScreeningVariant::Grow, 0.02, NDR::Dynamic, 0.05, false);
+  add("grow 0.02 near-dyn 20", ScreeningVariant::Grow, 0.02, NDR::NearDynamic, 0.05, false);
+  add("grow 0.02 dyn depth-only dil", ScreeningVariant::Grow, 0.02, NDR::Dynamic, 0.05, true);
+  add("grow 0.02 near-dyn 20 depth-only dil", ScreeningVariant::Grow, 0.02, NDR::NearDynamic, 0.05, true);
+  for (double thr : {0.02, 0.05}) {
+    for (double frac : {0.2, 0.3, 0.5}) {
+      for (NDR nd : {NDR::Dynamic, NDR::NearDynamic}) {
+        for (bool depth_only : {false, true}) {
+          char buf[160];
+          std::snprintf(buf, sizeof buf, "nearest %.2f frac %.1f %s%s", thr, frac,
+                        nd == NDR::Dynamic ? "dyn" : "near-dyn 20",
+                        depth_only ? " depth-only dil" : "");
+          add(buf, ScreeningVariant::Nearest, thr, nd, 0.05, depth_only, frac);
+        }
+      }
+    }
+  }
+  for (double r : {10.0, 30.0, 40.0, 60.0})
+    for (double dil : {0.05, 0.1}) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "nearest 0.02 frac 0.3 near-dyn %.0f depth-only dil %.2f", r, dil);
+      add(buf, ScreeningVariant::Nearest, 0.02, NDR::NearDynamic, dil, true, 0.3, r);
+    }
+  add("nearest 0.02 frac 0.3 near-dyn 40 dil 0.05", ScreeningVariant::Nearest, 0.02,
+      NDR::NearDynamic, 0.05, false, 0.3, 40);
+  add("nearest 0.02 frac 0.3 near-dyn 40 no dilation", ScreeningVariant::Nearest, 0.02,
+      NDR::NearDynamic, 0.0, false, 0.3, 40);
+  return v;
+}
 
 int g_border = 0;  // --border: pixels of the mask boundary left out of the metrics
 
@@ -199,6 +253,14 @@ void sweep(const RealFrame& rf, int seeds) {
               qg.retention, qg.dropped);
 }
 
+void variantsTable(const RealFrame& rf, int seeds) {
+  std::printf("\n| configuration (dilation 0.05 unless named) | dynamic recall | static kept in boxes | dropped |\n|---|---|---|---|\n");
+  for (const auto& c : variantConfigs()) {
+    Quality q = quality(rf, c.o, seeds);
+    std::printf("| %s | %.3f | %.3f | %.1f |\n", c.name.c_str(), q.recall, q.retention, q.dropped);
+  }
+}
+
 void timing(const RealFrame& rf, int reps) {
   std::printf("\n| mode | variant | in boxes | dropped | iterations | median ms | p95 ms |\n|---|---|---|---|---|---|---|\n");
   for (DynamicMode m : {DynamicMode::Detect, DynamicMode::Geometry, DynamicMode::DetectGeometry}) {
@@ -283,6 +345,7 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
   add("grow 0.05 noDepth nearest", ScreeningVariant::Grow, 0.05, NDR::Nearest);
   add("grow 0.1 noDepth nearest", ScreeningVariant::Grow, 0.1, NDR::Nearest);
   add("paper 0.43 noDepth nearest", ScreeningVariant::Paper, 0.43, NDR::Nearest);
+  for (const auto& c : variantConfigs()) cfgs.push_back({c.name, c.o});
   std::vector<ScreeningMetrics> total(cfgs.size());
   ScreeningMetrics det_total;
 
@@ -336,7 +399,7 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
 int main(int argc, char** argv) {
   try {
     int reps = 200, seeds = 20;
-    bool use_detector = false, do_sweep = false;
+    bool use_detector = false, do_sweep = false, do_variants = false;
     std::string sequence;
     int stride = 10;
     for (int i = 1; i < argc; ++i) {
@@ -349,10 +412,11 @@ int main(int argc, char** argv) {
       else if (a == "--seeds") seeds = std::stoi(next());
       else if (a == "--detector") use_detector = true;
       else if (a == "--sweep") do_sweep = true;
+      else if (a == "--variants") do_variants = true;
       else if (a == "--border") g_border = std::stoi(next());
       else if (a == "--sequence") sequence = next();
       else if (a == "--stride") stride = std::stoi(next());
-      else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep] [--border PX] | --sequence DIR [--stride N] [--detector]");
+      else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep] [--variants] [--border PX] | --sequence DIR [--stride N] [--detector]");
     }
     if (reps < 1 || seeds < 1 || stride < 1) throw Error("--reps, --seeds and --stride must be >= 1");
     if (!sequence.empty()) {
@@ -362,6 +426,8 @@ int main(int argc, char** argv) {
     RealFrame rf = loadRealFrame(use_detector);
     printCounts(rf);
     if (do_sweep) sweep(rf, seeds);
+    if (do_sweep || do_variants) variantsTable(rf, seeds);
+    if (do_variants) return 0;
     timing(rf, reps);
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -38,11 +38,17 @@ std::string toString(DynamicMode m) {
 ScreeningVariant parseScreeningVariant(const std::string& s) {
   if (s == "paper") return ScreeningVariant::Paper;
   if (s == "grow") return ScreeningVariant::Grow;
-  throw Error("unknown screening variant '" + s + "'; use paper or grow");
+  if (s == "nearest") return ScreeningVariant::Nearest;
+  throw Error("unknown screening variant '" + s + "'; use paper, grow or nearest");
 }
 
 std::string toString(ScreeningVariant v) {
-  return v == ScreeningVariant::Paper ? "paper" : "grow";
+  switch (v) {
+    case ScreeningVariant::Paper: return "paper";
+    case ScreeningVariant::Grow: return "grow";
+    case ScreeningVariant::Nearest: return "nearest";
+  }
+  return "?";
 }
 
 void ScreeningOptions::validate(const std::string& where) const {
@@ -58,6 +64,10 @@ void ScreeningOptions::validate(const std::string& where) const {
     bad("growRadius must be > 0 (pixels), got " + std::to_string(grow_radius_px));
   if (!(grow_depth_m > 0) || !std::isfinite(grow_depth_m))
     bad("growDepth must be > 0 (metres), got " + std::to_string(grow_depth_m));
+  if (!(cluster_min_fraction > 0 && cluster_min_fraction <= 1))
+    bad("clusterMinFraction must be in (0, 1], got " + std::to_string(cluster_min_fraction));
+  if (!(no_depth_radius_px > 0) || !std::isfinite(no_depth_radius_px))
+    bad("noDepthRadius must be > 0 (pixels), got " + std::to_string(no_depth_radius_px));
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
@@ -84,19 +94,25 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   int seed = cfg.getInt("Screening.seed", static_cast<int>(o.seed));
   if (seed < 0) throw Error(file + ": key 'Screening.seed' must be >= 0, got " + std::to_string(seed));
   o.seed = static_cast<unsigned>(seed);
-  std::string nd = cfg.getString("Screening.noDepth", "dynamic");
+  static const char* const kNoDepthNames[] = {"dynamic", "static", "nearest", "near-dynamic"};
+  std::string nd = cfg.getString("Screening.noDepth", kNoDepthNames[static_cast<int>(o.no_depth)]);
   if (nd == "dynamic") {
     o.no_depth = NoDepthRule::Dynamic;
   } else if (nd == "static") {
     o.no_depth = NoDepthRule::Static;
   } else if (nd == "nearest") {
     o.no_depth = NoDepthRule::Nearest;
+  } else if (nd == "near-dynamic") {
+    o.no_depth = NoDepthRule::NearDynamic;
   } else {
-    throw Error(file + ": key 'Screening.noDepth' must be dynamic, static or nearest, got '" + nd + "'");
+    throw Error(file + ": key 'Screening.noDepth' must be dynamic, static, nearest or near-dynamic, got '" + nd + "'");
   }
   o.box_dilation = cfg.getDouble("Screening.boxDilation", o.box_dilation);
   o.grow_radius_px = cfg.getDouble("Screening.growRadius", o.grow_radius_px);
   o.grow_depth_m = cfg.getDouble("Screening.growDepth", o.grow_depth_m);
+  o.cluster_min_fraction = cfg.getDouble("Screening.clusterMinFraction", o.cluster_min_fraction);
+  o.no_depth_radius_px = cfg.getDouble("Screening.noDepthRadius", o.no_depth_radius_px);
+  o.dilation_depth_only = cfg.getBool("Screening.dilationDepthOnly", o.dilation_depth_only);
   o.validate(file + ": Screening.*");
   return o;
 }
@@ -167,6 +183,37 @@ ConsensusResult Screener::depthRansac(const std::vector<float>& depths, unsigned
   return res;
 }
 
+std::vector<int> Screener::nearestCluster(const std::vector<float>& depths) const {
+  const int n = static_cast<int>(depths.size());
+  std::vector<int> out;
+  if (n == 0) return out;
+  // Half-width of Algorithm 1's consensus window for a tight pair: |d - m2| < sqrt(4.5 T).
+  const double h = std::sqrt(4.5 * opt_.variance_threshold_m2);
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return depths[a] < depths[b]; });
+  // Window count around every keypoint's depth (two pointers over the sorted depths).
+  std::vector<int> count(n);
+  int lo = 0, hi = 0, best = 0;
+  for (int k = 0; k < n; ++k) {
+    const double c = depths[order[k]];
+    while (depths[order[lo]] <= c - h) ++lo;
+    while (hi < n && depths[order[hi]] < c + h) ++hi;
+    count[k] = hi - lo;
+    best = std::max(best, count[k]);
+  }
+  const int need = std::max(1, static_cast<int>(std::ceil(opt_.cluster_min_fraction * best)));
+  // Nearest sizeable window; then climb to the local maximum of the count so the window is
+  // centred on the cluster rather than on its near edge.
+  int k = 0;
+  while (count[k] < need) ++k;
+  while (k + 1 < n && count[k + 1] >= count[k] && depths[order[k + 1]] < depths[order[k]] + h) ++k;
+  const double c = depths[order[k]];
+  for (int i = 0; i < n; ++i)
+    if (std::abs(depths[i] - c) < h) out.push_back(i);
+  return out;
+}
+
 void Screener::grow(const std::vector<cv::Point2f>& pts, const std::vector<float>& depths,
                     std::vector<uint8_t>& member) const {
   const size_t n = pts.size();
@@ -228,7 +275,8 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
   // are independent of each other and of previous frames.
   std::vector<cv::Point2f> pts;
   std::vector<uint8_t> member;
-  auto screenRegion = [&](const std::vector<int>& idx, unsigned region) {
+  // core: the detected (undilated) box when dilation_depth_only, else null.
+  auto screenRegion = [&](const std::vector<int>& idx, unsigned region, const cv::Rect2f* core) {
     depths.clear();
     members.clear();
     pts.clear();
@@ -239,19 +287,37 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
         pts.push_back(frame.keypoints[i].pt);
       }
     }
-    ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
-    st.iterations += r.iterations;
     member.assign(depths.size(), 0);
-    for (int m : r.members) member[m] = 1;
-    if (opt_.variant == ScreeningVariant::Grow) grow(pts, depths, member);
+    if (opt_.variant == ScreeningVariant::Nearest) {
+      for (int m : nearestCluster(depths)) member[m] = 1;
+    } else {
+      ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
+      st.iterations += r.iterations;
+      for (int m : r.members) member[m] = 1;
+    }
+    if (opt_.variant != ScreeningVariant::Paper) grow(pts, depths, member);
     for (size_t m = 0; m < member.size(); ++m)
       if (member[m]) drop[members[m]] = 1;
     if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
     const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
+    const float nd2 = static_cast<float>(opt_.no_depth_radius_px * opt_.no_depth_radius_px);
     for (int i : idx) {
       if (frame.depth[i] > 0) continue;
+      if (core && !inside(*core, frame.keypoints[i].pt)) continue;  // dilation ring: depth only
       if (opt_.no_depth == ScreeningOptions::NoDepthRule::Dynamic) {
         drop[i] = 1;
+        continue;
+      }
+      if (opt_.no_depth == ScreeningOptions::NoDepthRule::NearDynamic) {
+        const cv::Point2f p = frame.keypoints[i].pt;
+        for (size_t m = 0; m < pts.size(); ++m) {
+          if (!member[m]) continue;
+          const float dx = pts[m].x - p.x, dy = pts[m].y - p.y;
+          if (dx * dx + dy * dy < nd2) {
+            drop[i] = 1;
+            break;
+          }
+        }
         continue;
       }
       // Nearest: copy the label of the closest keypoint with depth within the radius.
@@ -275,7 +341,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
     // The whole image is one box.
     for (size_t i = 0; i < n; ++i) idx.push_back(static_cast<int>(i));
     std::fill(in_any.begin(), in_any.end(), 1);
-    screenRegion(idx, 0);
+    screenRegion(idx, 0, nullptr);
   } else {
     unsigned region = 0;
     for (const auto& box : boxes) {
@@ -290,7 +356,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
       if (opt_.mode == DynamicMode::Detect) {
         for (int i : idx) drop[i] = 1;
       } else {
-        screenRegion(idx, region);
+        screenRegion(idx, region, opt_.dilation_depth_only ? &box.rect : nullptr);
       }
       ++region;
     }

@@ -141,10 +141,20 @@ TEST(Modes, BehaveAsSpecified) {
   // Geometry: the whole image is one box; the dominant depth cluster is the wall (160 of 280
   // keypoints), which G drops: the paper's reason why G alone is worse than D + G.
   Scene geo = makeScene();
-  st = run(DynamicMode::Geometry, geo);
+  ScreeningOptions po;
+  po.mode = DynamicMode::Geometry;
+  po.variant = ScreeningVariant::Paper;
+  po.variance_threshold_m2 = 0.05;
+  st = Screener(po).screen(geo.frame, geo.boxes);
   EXPECT_EQ(st.in_boxes, 280);
   EXPECT_EQ(geo.frame.countDynamic(), 160u);
   for (size_t i = 0; i < geo.frame.size(); ++i) EXPECT_EQ(geo.frame.dynamic[i], geo.person[i] ? 0 : 1);
+  // The nearest variant (default) takes the nearer cluster, the person, even without boxes.
+  Scene geo_near = makeScene();
+  st = run(DynamicMode::Geometry, geo_near);
+  EXPECT_EQ(st.in_boxes, 280);
+  for (size_t i = 0; i < geo_near.frame.size(); ++i)
+    EXPECT_EQ(geo_near.frame.dynamic[i], geo_near.person[i] ? 1 : 0);
 
   Scene dg = makeScene();
   run(DynamicMode::DetectGeometry, dg);
@@ -323,4 +333,88 @@ TEST(Metrics, IgnoredBorderBand) {
   EXPECT_EQ(core.dynamic_dropped, 1);
   EXPECT_EQ(core.static_in_boxes, 1);
   EXPECT_EQ(core.static_in_boxes_kept, 1);
+}
+
+TEST(NearestVariant, PersonIsTheNearestClusterWhenTheBackgroundDominatesTheBox) {
+  // A sitting person (60 keypoints, 1.8-2.0 m) in a box filled mostly by a desk/wall at 3.5 m
+  // (150 keypoints): Algorithm 1's "largest set" is the background, the nearest sizeable
+  // cluster is the person.
+  Scene s = makeScene(2, 60, 150, 50);
+  for (size_t i = 0; i < s.frame.size(); ++i)
+    s.frame.depth[i] = s.person[i] ? 1.8f + 0.2f * (i % 7) / 6.f : 3.4f + 0.2f * (i % 5) / 4.f;
+  auto count = [&](const Scene& t, bool person) {
+    int dropped = 0;
+    for (size_t i = 0; i < t.frame.size(); ++i)
+      if (t.person[i] == person && t.boxes[0].rect.contains(t.frame.keypoints[i].pt))
+        dropped += t.frame.dynamic[i];
+    return dropped;
+  };
+  ScreeningOptions o;
+  o.box_dilation = 0;
+  o.variant = ScreeningVariant::Paper;
+  Scene p = s;
+  Screener(o).screen(p.frame, p.boxes);
+  EXPECT_EQ(count(p, true), 0);      // the paper's rule drops the background ...
+  EXPECT_EQ(count(p, false), 150);   // ... and keeps the person
+  o.variant = ScreeningVariant::Nearest;
+  Scene q = s;
+  Screener(o).screen(q.frame, q.boxes);
+  EXPECT_EQ(count(q, true), 60);
+  EXPECT_EQ(count(q, false), 0);
+  // A handful of near outliers (below cluster_min_fraction of the largest window) is not
+  // taken for the person.
+  std::vector<float> d(q.frame.depth.begin(), q.frame.depth.begin() + 210);
+  d.push_back(0.8f);
+  d.push_back(0.82f);
+  std::vector<int> m = Screener(o).nearestCluster(d);
+  EXPECT_EQ(m.size(), 60u);
+  for (int i : m) EXPECT_LT(i, 60);
+  EXPECT_TRUE(Screener(o).nearestCluster({}).empty());
+}
+
+TEST(Screener, NearDynamicRuleAndDepthOnlyDilation) {
+  Scene s = makeScene();
+  s.frame.dynamic.assign(s.frame.size(), 0);
+  // Depth-less keypoints: on the person (5 px from a person keypoint), in the wall part of the
+  // box far from the person, and in the dilation ring right of the box.
+  const cv::Point2f on_person = s.frame.keypoints[0].pt + cv::Point2f(5, 0);
+  s.frame.keypoints.emplace_back(on_person, 31.f);
+  s.frame.keypoints.emplace_back(cv::Point2f(102, 250), 31.f);
+  s.frame.keypoints.emplace_back(cv::Point2f(304, 250), 31.f);
+  for (int k = 0; k < 3; ++k) s.frame.depth.push_back(0.f);
+  const size_t n = s.frame.size();
+  ScreeningOptions o;
+  o.variance_threshold_m2 = 0.05;
+  o.variant = ScreeningVariant::Nearest;
+  o.no_depth = ScreeningOptions::NoDepthRule::NearDynamic;
+  o.no_depth_radius_px = 20;
+  o.box_dilation = 0.05;  // box x in [90, 310)
+  Scene a = s;
+  Screener(o).screen(a.frame, a.boxes);
+  EXPECT_EQ(a.frame.dynamic[n - 3], 1);  // next to the person
+  EXPECT_EQ(a.frame.dynamic[n - 2], 0);  // wall region: the person starts 48 px away
+  EXPECT_EQ(a.frame.dynamic[n - 1], 0);
+  o.no_depth = ScreeningOptions::NoDepthRule::Dynamic;
+  Scene b = s;
+  Screener(o).screen(b.frame, b.boxes);
+  EXPECT_EQ(b.frame.dynamic[n - 2], 1);
+  EXPECT_EQ(b.frame.dynamic[n - 1], 1);  // the dilation ring drops depth-less keypoints too
+  o.dilation_depth_only = true;
+  Scene c = s;
+  Screener(o).screen(c.frame, c.boxes);
+  EXPECT_EQ(c.frame.dynamic[n - 2], 1);  // inside the detected box: the rule applies
+  EXPECT_EQ(c.frame.dynamic[n - 1], 0);  // ring: only depth can make it dynamic
+  EXPECT_EQ(c.frame.dynamic[n - 3], 1);
+
+  Config cfg = Config::fromString(
+      "Screening.variant: \"nearest\"\nScreening.noDepth: \"near-dynamic\"\n"
+      "Screening.noDepthRadius: 12\nScreening.clusterMinFraction: 0.4\n"
+      "Screening.dilationDepthOnly: true\n", "s.yaml");
+  ScreeningOptions l = ScreeningOptions::load(cfg);
+  EXPECT_EQ(l.variant, ScreeningVariant::Nearest);
+  EXPECT_EQ(l.no_depth, ScreeningOptions::NoDepthRule::NearDynamic);
+  EXPECT_DOUBLE_EQ(l.no_depth_radius_px, 12);
+  EXPECT_DOUBLE_EQ(l.cluster_min_fraction, 0.4);
+  EXPECT_TRUE(l.dilation_depth_only);
+  EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.clusterMinFraction: 0\n", "b.yaml")), Error);
 }

@@ -1,8 +1,10 @@
 #pragma once
 // Dynamic-feature screening (YOLO-SLAM Algorithm 1, "depth-RANSAC"): inside each person box the
 // largest set of keypoints whose depths agree (3-point depth variance under a threshold) is the
-// person and is marked dynamic; the rest of the box stays static. See docs/screening.md for the
-// meaning and units of the paper's nThre = 0.43 and the measurements behind the defaults.
+// person and is marked dynamic; the rest of the box stays static (variant "paper"). The default
+// variant "nearest" takes the nearest sizeable depth cluster instead (people occlude the
+// background). See docs/screening.md for the meaning and units of the paper's nThre = 0.43 and
+// the measurements behind the defaults.
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 
@@ -34,13 +36,19 @@ std::string toString(DynamicMode m);
 //       (single linkage, to convergence). A person's depth spans 0.5 m and more (limbs, and a
 //       camera tilted down sees the feet deeper than the torso), more than one variance window
 //       holds without swallowing the background; depth-continuity in the image follows it.
-enum class ScreeningVariant { Paper, Grow };
+// nearest: beyond the paper. The person is the NEAREST sizeable depth cluster of the box, not
+//       the largest: a person occludes what is behind, so in a box where the background holds
+//       more keypoints than the person (sitting people, loose or dilated boxes) the largest set
+//       is the background. Clusters are depth windows of the same half-width as Algorithm 1's
+//       consensus for a tight pair (sqrt(4.5 nThre)); the nearest window holding at least
+//       cluster_min_fraction of the largest window's count is the person, then the grow step.
+enum class ScreeningVariant { Paper, Grow, Nearest };
 ScreeningVariant parseScreeningVariant(const std::string& s);
 std::string toString(ScreeningVariant v);
 
 struct ScreeningOptions {
   DynamicMode mode = DynamicMode::DetectGeometry;
-  ScreeningVariant variant = ScreeningVariant::Grow;
+  ScreeningVariant variant = ScreeningVariant::Nearest;
   // nThre: threshold on the population variance (Eq. 5) of the depths of the two sampled
   // keypoints plus the candidate (N = 3), in square metres. The paper's 0.43 read as m^2 merges
   // people with the desk behind them; 0.02 measured best (docs/screening.md).
@@ -51,18 +59,29 @@ struct ScreeningOptions {
   // Rule for in-box keypoints without valid depth (depth <= 0): Dynamic (depth holes in a
   // person box sit mostly on the person's silhouette and hair), Static, or Nearest: the label
   // of the nearest in-box keypoint with depth (within grow_radius_px; static if none).
-  enum class NoDepthRule { Dynamic, Static, Nearest };
-  NoDepthRule no_depth = NoDepthRule::Dynamic;
+  // NearDynamic: dynamic when a keypoint with depth declared dynamic lies within
+  // no_depth_radius_px, static otherwise (holes on a person's outline have dynamic neighbours;
+  // far background beyond the sensor's range has none).
+  enum class NoDepthRule { Dynamic, Static, Nearest, NearDynamic };
+  NoDepthRule no_depth = NoDepthRule::NearDynamic;
   // Grow each box by this fraction of its width/height per side: detector boxes clip heads
   // and feet (measured gain with detector boxes, docs/screening.md).
   double box_dilation = 0.05;
   double grow_radius_px = 30;   // grow variant: pixel radius of the linkage
   double grow_depth_m = 0.1;    // grow variant: depth difference of the linkage (metres)
+  // nearest variant: a depth cluster counts as "sizeable" when it holds at least this fraction
+  // of the keypoints of the box's largest cluster.
+  double cluster_min_fraction = 0.3;
+  double no_depth_radius_px = 40;  // NearDynamic rule: radius in pixels
+  // When true, the dilation ring around a box (box_dilation) only takes keypoints whose depth
+  // joins the person's set; the no-depth rule applies inside the detected box only.
+  bool dilation_depth_only = false;
 
   // Reads Screening.mode, Screening.variant, Screening.varianceThreshold (m^2),
   // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
   // ("dynamic" | "static" | "nearest"), Screening.boxDilation, Screening.growRadius (px),
-  // Screening.growDepth (m). Invalid values throw
+  // Screening.growDepth (m), Screening.clusterMinFraction, Screening.noDepthRadius (px),
+  // Screening.dilationDepthOnly (bool). Invalid values throw
   // yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // Throws yolo_slam::Error (prefixed by `where`) if a value is out of range.
@@ -102,6 +121,11 @@ class Screener {
   // Algorithm 1 on a set of valid depths (metres, all > 0) with the given RNG seed (the paper
   // variant; the grow step needs pixel positions and runs in screen()).
   ConsensusResult depthRansac(const std::vector<float>& depths, unsigned seed) const;
+
+  // The nearest variant's cluster choice on a set of valid depths (deterministic): indices of
+  // the keypoints within sqrt(4.5 nThre) of the nearest window centre whose window holds at
+  // least cluster_min_fraction of the largest window's count.
+  std::vector<int> nearestCluster(const std::vector<float>& depths) const;
 
   // The grow step: extends `member` (flags over pts/depths, all depths > 0) by single linkage.
   void grow(const std::vector<cv::Point2f>& pts, const std::vector<float>& depths,
