@@ -3,6 +3,7 @@
 // photographs under synthetic changes of viewpoint.
 //
 //   vocabulary_bench [--vocab FILE] [--warps 3] [--strength 1.0] [--skip-synthetic]
+#include "yolo_slam/common/cli.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/timing.h"
@@ -182,11 +183,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return yolo_slam::runGuarded(run, argc, argv); }

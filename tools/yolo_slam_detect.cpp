@@ -1,5 +1,6 @@
 // yolo_slam_detect: runs the person detector on images and prints the boxes (text or JSON),
 // optionally drawing them to PNG files.
+#include "yolo_slam/common/cli.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/json.h"
 #include "yolo_slam/common/paths.h"
@@ -150,12 +151,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cout.flush();
-    std::cerr << "error: " << e.what() << "\n";
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return yolo_slam::runGuarded(run, argc, argv); }

@@ -6,6 +6,7 @@
 //                         [--iterations 10] [--weighting tf-idf|tf|idf|binary] [--text] INPUT...
 //
 // INPUT: image folders, image lists (.txt), videos or single images.
+#include "yolo_slam/common/cli.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/progress.h"
 #include "yolo_slam/common/timing.h"
@@ -131,11 +132,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return yolo_slam::runGuarded(run, argc, argv); }
