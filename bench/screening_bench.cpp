@@ -264,8 +264,8 @@ void variantsTable(const RealFrame& rf, int seeds) {
 void timing(const RealFrame& rf, int reps) {
   std::printf("\n| mode | variant | in boxes | dropped | iterations | median ms | p95 ms |\n|---|---|---|---|---|---|---|\n");
   for (DynamicMode m : {DynamicMode::Detect, DynamicMode::Geometry, DynamicMode::DetectGeometry}) {
-    for (ScreeningVariant v : {ScreeningVariant::Paper, ScreeningVariant::Grow}) {
-      if (m == DynamicMode::Detect && v == ScreeningVariant::Grow) continue;
+    for (ScreeningVariant v : {ScreeningVariant::Paper, ScreeningVariant::Grow, ScreeningVariant::Nearest}) {
+      if (m == DynamicMode::Detect && v != ScreeningVariant::Paper) continue;
       ScreeningOptions o;
       o.mode = m;
       o.variant = v;
