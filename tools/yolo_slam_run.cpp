@@ -10,6 +10,7 @@
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/detection/detector.h"
 #include "yolo_slam/eval/ate.h"
+#include "yolo_slam/io/atomic_file.h"
 #include "yolo_slam/io/text_table.h"
 #include "yolo_slam/io/trajectory.h"
 #include "yolo_slam/io/tum_sequence.h"
@@ -378,9 +379,11 @@ int run(const Args& args) {
      << ",\n  \"tracked\": " << s.tracked << ",\n  \"lost\": " << s.lost
      << ",\n  \"trajectory_poses\": " << traj.size() << ",\n  \"keyframes\": " << s.keyframes
      << ",\n  \"keyframes_culled\": " << s.keyframes_culled << ",\n  \"map_points\": " << s.map_points
-     << ",\n  \"map_resets\": " << s.resets << ",\n  \"ate_rmse_m\": " << jsonNumber(ate_rmse, 6)
+     << ",\n  \"map_resets\": " << s.resets << ",\n  \"relocalizations\": " << s.relocalizations
+     << ",\n  \"loops_closed\": " << s.loops_closed << ",\n  \"global_bundle_adjustments\": " << s.global_bas
+     << ",\n  \"ate_rmse_m\": " << jsonNumber(ate_rmse, 6)
      << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
-     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 2)
+     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4)
      << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
      << ", \"dropped\": " << s.keypoints_dropped << "}"
      << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
@@ -394,13 +397,7 @@ int run(const Args& args) {
      << summaryField("local_mapping", s.local_mapping_ms) << ",\n"
      << summaryField("detection", s.detection_ms) << ",\n" << summaryField("frame", frame_ms) << "\n  }\n}\n";
   const std::string stats_path = joinPath(args.out, "stats.json");
-  {
-    std::ofstream f(stats_path + ".tmp");
-    f << js.str();
-    if (!f) throw Error(stats_path + ": cannot write; check the output folder");
-  }
-  if (std::rename((stats_path + ".tmp").c_str(), stats_path.c_str()) != 0)
-    throw Error(stats_path + ": cannot write; check the output folder");
+  io::writeFileAtomic(stats_path, js.str());
 
   std::printf("frames %zu, tracked %zu, lost %zu, keyframes %zu, map points %zu\n", s.frames, s.tracked, s.lost,
               s.keyframes, s.map_points);
