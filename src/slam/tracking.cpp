@@ -265,6 +265,12 @@ bool Tracking::trackMotionModel(Frame& F) {
     n = matcher::searchLastFrame(F, last_, 2.0 * opt_.motion_window);
   }
   if (n < 20) return false;
+  const int n_map = optimizePoseAndDropOutliers(F);
+  if (localization_only_) return n_map >= 10 || n >= 20;
+  return n_map >= 10;
+}
+
+int Tracking::optimizePoseAndDropOutliers(Frame& F) {
   optimizePose(F);
   int n_map = 0;
   for (int i = 0; i < F.N; ++i) {
@@ -277,8 +283,7 @@ bool Tracking::trackMotionModel(Frame& F) {
       ++n_map;
     }
   }
-  if (localization_only_) return n_map >= 10 || n >= 20;
-  return n_map >= 10;
+  return n_map;
 }
 
 bool Tracking::trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior,
@@ -308,18 +313,7 @@ bool Tracking::trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pos
     }
   }
   if (n < 15) return false;
-  optimizePose(F);
-  int n_map = 0;
-  for (int i = 0; i < F.N; ++i) {
-    if (!F.points[i]) continue;
-    if (F.outlier[i]) {
-      F.points[i]->last_seen_frame = F.id;
-      F.points[i].reset();
-      F.outlier[i] = false;
-    } else if (F.points[i]->numObservations() > 0) {
-      ++n_map;
-    }
-  }
+  const int n_map = optimizePoseAndDropOutliers(F);
   return n_map >= min_inliers;
 }
 

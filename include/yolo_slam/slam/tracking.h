@@ -74,6 +74,9 @@ class Tracking {
   void updateLocalMap(Frame& F);
   void searchLocalPoints(Frame& F);
   int optimizePose(Frame& F);
+  // Pose-only optimisation, then the outlier matches are released; returns the matches to
+  // points that are in the map (motion-model and reference-keyframe tracking).
+  int optimizePoseAndDropOutliers(Frame& F);
   bool needNewKeyFrame(const Frame& F) const;
   void createNewKeyFrame(Frame& F);
   void computeBow(Frame& F) const;
