@@ -174,14 +174,7 @@ bool Tracking::initialize(Frame& F) {
   map_.addKeyFrame(kf);
   for (int i = 0; i < F.N; ++i) {
     if (F.depth[i] <= 0 || F.dynamic[i]) continue;
-    Eigen::Vector3d Xw;
-    if (!F.unprojectWorld(i, Xw)) continue;
-    auto mp = std::make_shared<MapPoint>(map_.newPointId(), Xw, kf.get(), F.id);
-    Map::addObservation(mp, kf, i);
-    mp->computeDistinctiveDescriptor();
-    mp->updateNormalAndDepth();
-    map_.addMapPoint(mp);
-    F.points[i] = mp;
+    createDepthPoint(kf, F, i);
   }
   if (mapper_) mapper_->insertKeyFrame(kf);
   ref_kf_ = kf;
@@ -268,6 +261,19 @@ bool Tracking::trackMotionModel(Frame& F) {
   const int n_map = optimizePoseAndDropOutliers(F);
   if (localization_only_) return n_map >= 10 || n >= 20;
   return n_map >= 10;
+}
+
+bool Tracking::createDepthPoint(const KeyFramePtr& kf, Frame& F, int i) {
+  Eigen::Vector3d Xw;
+  if (!F.unprojectWorld(i, Xw)) return false;
+  auto mp = std::make_shared<MapPoint>(map_.newPointId(), Xw, kf.get(), F.id);
+  Map::addObservation(mp, kf, i);
+  mp->computeDistinctiveDescriptor();
+  mp->updateNormalAndDepth();
+  map_.addMapPoint(mp);
+  F.points[i] = mp;
+  F.outlier[i] = false;
+  return true;
 }
 
 int Tracking::optimizePoseAndDropOutliers(Frame& F) {
@@ -616,15 +622,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
     const int i = e.second;
     const MapPointPtr& cur = kf->f.points[i];
     if (!cur || cur->numObservations() < 1) {
-      Eigen::Vector3d Xw;
-      if (!F.unprojectWorld(i, Xw)) continue;
-      auto mp = std::make_shared<MapPoint>(map_.newPointId(), Xw, kf.get(), F.id);
-      Map::addObservation(mp, kf, i);
-      mp->computeDistinctiveDescriptor();
-      mp->updateNormalAndDepth();
-      map_.addMapPoint(mp);
-      F.points[i] = mp;
-      F.outlier[i] = false;
+      if (!createDepthPoint(kf, F, i)) continue;
     }
     ++n;
     if (e.first > cam_.closeDepth() && n > 100) break;

@@ -77,6 +77,9 @@ class Tracking {
   // Pose-only optimisation, then the outlier matches are released; returns the matches to
   // points that are in the map (motion-model and reference-keyframe tracking).
   int optimizePoseAndDropOutliers(Frame& F);
+  // A map point from keypoint i of F (with depth), observed by kf; caller holds the map mutex.
+  // Returns false when the keypoint cannot be back-projected.
+  bool createDepthPoint(const KeyFramePtr& kf, Frame& F, int i);
   bool needNewKeyFrame(const Frame& F) const;
   void createNewKeyFrame(Frame& F);
   void computeBow(Frame& F) const;
