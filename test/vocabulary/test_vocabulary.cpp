@@ -1,6 +1,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/vocabulary/trainer.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
+#include "vocabulary/temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -9,16 +10,12 @@
 #include <iterator>
 #include <random>
 #include <sstream>
-#include <unistd.h>
 
 using namespace yolo_slam;
 using namespace yolo_slam::vocabulary;
+using yolo_slam::vocab_test::ScopedTempDir;
 
 namespace {
-
-std::string tmpPath(const std::string& name) {
-  return "/tmp/ys_vocab_test_" + std::to_string(::getpid()) + "_" + name;
-}
 
 std::string readBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -81,9 +78,11 @@ std::string handWrittenOrbVoc() {
 }  // namespace
 
 TEST(Vocabulary, SaveLoadRoundTripIsBitIdentical) {
+  ScopedTempDir tmp;
+  ASSERT_TRUE(tmp.ok());
   auto v = smallVocab();
   ASSERT_GT(v->size(), 16u);
-  const std::string a = tmpPath("a.vocab"), b = tmpPath("b.vocab");
+  const std::string a = tmp.file("a.vocab"), b = tmp.file("b.vocab");
   v->save(a);
   auto w = Vocabulary::load(a);
   EXPECT_TRUE(v->identical(*w));
@@ -100,13 +99,13 @@ TEST(Vocabulary, SaveLoadRoundTripIsBitIdentical) {
   w->transform(imgs[0], bw, fw, 1);
   EXPECT_EQ(bv, bw);
   EXPECT_EQ(fv, fw);
-  std::remove(a.c_str());
-  std::remove(b.c_str());
 }
 
 TEST(Vocabulary, CorruptOrMissingFilesAreErrorsNamingTheFile) {
+  ScopedTempDir tmp;
+  ASSERT_TRUE(tmp.ok());
   auto v = smallVocab();
-  const std::string p = tmpPath("c.vocab");
+  const std::string p = tmp.file("c.vocab");
   v->save(p);
   const std::string good = readBytes(p);
 
@@ -148,7 +147,9 @@ TEST(Vocabulary, CorruptOrMissingFilesAreErrorsNamingTheFile) {
 }
 
 TEST(Vocabulary, ReadsHandWrittenOrbVocText) {
-  const std::string p = tmpPath("orbvoc.txt");
+  ScopedTempDir tmp;
+  ASSERT_TRUE(tmp.ok());
+  const std::string p = tmp.file("orbvoc.txt");
   writeBytes(p, handWrittenOrbVoc());
   auto v = Vocabulary::load(p);
   EXPECT_EQ(v->branching(), 2);
@@ -186,18 +187,17 @@ TEST(Vocabulary, ReadsHandWrittenOrbVocText) {
   EXPECT_EQ(fv[2], (std::vector<unsigned>{2}));
 
   // Text writer and binary round trip keep the same vocabulary.
-  const std::string t2 = tmpPath("orbvoc2.txt"), b = tmpPath("orbvoc.vocab");
+  const std::string t2 = tmp.file("orbvoc2.txt"), b = tmp.file("orbvoc.vocab");
   v->saveText(t2);
   EXPECT_TRUE(Vocabulary::loadText(t2)->identical(*v));
   v->save(b);
   EXPECT_TRUE(Vocabulary::load(b)->identical(*v));
-  std::remove(p.c_str());
-  std::remove(t2.c_str());
-  std::remove(b.c_str());
 }
 
 TEST(Vocabulary, TextReaderErrorsNameFileAndLine) {
-  const std::string p = tmpPath("bad.txt");
+  ScopedTempDir tmp;
+  ASSERT_TRUE(tmp.ok());
+  const std::string p = tmp.file("bad.txt");
   auto expectError = [&](const std::string& text, const std::string& needle) {
     writeBytes(p, text);
     try {
@@ -214,7 +214,6 @@ TEST(Vocabulary, TextReaderErrorsNameFileAndLine) {
   expectError("2 2 3 0\n" + descLine(0, 1, 0, 0), "scoring");                            // unsupported
   expectError("2 2 0 0\n" + descLine(0, 0, 0, 0), "no children");                        // inner w/o kids
   expectError("", "empty");
-  std::remove(p.c_str());
 }
 
 TEST(Vocabulary, ScoreProperties) {
