@@ -1,4 +1,5 @@
 #include "yolo_slam/screening/screener.h"
+#include "yolo_slam/screening/flat_box.h"
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -68,6 +69,20 @@ void ScreeningOptions::validate(const std::string& where) const {
     bad("clusterMinFraction must be in (0, 1], got " + std::to_string(cluster_min_fraction));
   if (!(no_depth_radius_px > 0) || !std::isfinite(no_depth_radius_px))
     bad("noDepthRadius must be > 0 (pixels), got " + std::to_string(no_depth_radius_px));
+  if (!(flat_box_fraction > 0 && flat_box_fraction <= 1))
+    bad("flatBoxFraction must be in (0, 1], got " + std::to_string(flat_box_fraction));
+  if (!(flat_box_tolerance > 0) || !std::isfinite(flat_box_tolerance))
+    bad("flatBoxTolerance must be > 0 (1/m, inverse depth), got " + std::to_string(flat_box_tolerance));
+  if (!(flat_box_ring > 0 && flat_box_ring <= 2))
+    bad("flatBoxRing must be in (0, 2] (fraction of the box size), got " + std::to_string(flat_box_ring));
+  if (track_max_age < 1)
+    bad("trackMaxAge must be >= 1 (frames), got " + std::to_string(track_max_age));
+  if (!(track_radius_px > 0) || !std::isfinite(track_radius_px))
+    bad("trackRadius must be > 0 (pixels), got " + std::to_string(track_radius_px));
+  if (track_max_hamming < 0 || track_max_hamming > 256)
+    bad("trackMaxHamming must be in [0, 256] (bits), got " + std::to_string(track_max_hamming));
+  if (track_min_matches < 1)
+    bad("trackMinMatches must be >= 1, got " + std::to_string(track_min_matches));
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
@@ -113,6 +128,15 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   o.cluster_min_fraction = cfg.getDouble("Screening.clusterMinFraction", o.cluster_min_fraction);
   o.no_depth_radius_px = cfg.getDouble("Screening.noDepthRadius", o.no_depth_radius_px);
   o.dilation_depth_only = cfg.getBool("Screening.dilationDepthOnly", o.dilation_depth_only);
+  o.reject_flat_boxes = cfg.getBool("Screening.rejectFlatBoxes", o.reject_flat_boxes);
+  o.flat_box_fraction = cfg.getDouble("Screening.flatBoxFraction", o.flat_box_fraction);
+  o.flat_box_tolerance = cfg.getDouble("Screening.flatBoxTolerance", o.flat_box_tolerance);
+  o.flat_box_ring = cfg.getDouble("Screening.flatBoxRing", o.flat_box_ring);
+  o.track_boxes = cfg.getBool("Screening.trackBoxes", o.track_boxes);
+  o.track_max_age = cfg.getInt("Screening.trackMaxAge", o.track_max_age);
+  o.track_radius_px = cfg.getDouble("Screening.trackRadius", o.track_radius_px);
+  o.track_max_hamming = cfg.getInt("Screening.trackMaxHamming", o.track_max_hamming);
+  o.track_min_matches = cfg.getInt("Screening.trackMinMatches", o.track_min_matches);
   o.validate(file + ": Screening.*");
   return o;
 }
@@ -275,8 +299,10 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
   // are independent of each other and of previous frames.
   std::vector<cv::Point2f> pts;
   std::vector<uint8_t> member;
-  // core: the detected (undilated) box when dilation_depth_only, else null.
-  auto screenRegion = [&](const std::vector<int>& idx, unsigned region, const cv::Rect2f* core) {
+  // core: the detected (undilated) box when dilation_depth_only, else null. region_box: the
+  // (dilated) box of a detection for the flat-box rule, null in geometry mode.
+  auto screenRegion = [&](const std::vector<int>& idx, unsigned region, const cv::Rect2f* core,
+                          const cv::Rect2f* region_box) {
     depths.clear();
     members.clear();
     pts.clear();
@@ -296,6 +322,20 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
       for (int m : r.members) member[m] = 1;
     }
     if (opt_.variant != ScreeningVariant::Paper) grow(pts, depths, member);
+    if (region_box && opt_.reject_flat_boxes) {
+      std::vector<int> cluster;
+      for (size_t m = 0; m < member.size(); ++m)
+        if (member[m]) cluster.push_back(members[m]);
+      FlatBoxOptions fo;
+      fo.ring = opt_.flat_box_ring;
+      fo.tolerance = opt_.flat_box_tolerance;
+      fo.fraction = opt_.flat_box_fraction;
+      fo.seed = opt_.seed + 7919u * region;
+      if (testFlatBox(frame, *region_box, cluster, fo).flat) {
+        ++st.flat_boxes;
+        return;  // a picture or static surface: nothing in this box is dropped
+      }
+    }
     for (size_t m = 0; m < member.size(); ++m)
       if (member[m]) drop[members[m]] = 1;
     if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
@@ -341,7 +381,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
     // The whole image is one box.
     for (size_t i = 0; i < n; ++i) idx.push_back(static_cast<int>(i));
     std::fill(in_any.begin(), in_any.end(), 1);
-    screenRegion(idx, 0, nullptr);
+    screenRegion(idx, 0, nullptr, nullptr);
   } else {
     unsigned region = 0;
     for (const auto& box : boxes) {
@@ -356,7 +396,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
       if (opt_.mode == DynamicMode::Detect) {
         for (int i : idx) drop[i] = 1;
       } else {
-        screenRegion(idx, region, opt_.dilation_depth_only ? &box.rect : nullptr);
+        screenRegion(idx, region, opt_.dilation_depth_only ? &box.rect : nullptr, &r);
       }
       ++region;
     }

@@ -76,6 +76,25 @@ struct ScreeningOptions {
   // When true, the dilation ring around a box (box_dilation) only takes keypoints whose depth
   // joins the person's set; the no-depth rule applies inside the detected box only.
   bool dilation_depth_only = false;
+  // Flat-box rule (screening/flat_box.h, beyond the paper; detect+geometry only): when the set
+  // a box would drop lies on one plane (inverse depth affine in u, v) that continues into a
+  // ring around the box (flat_box_fraction of the ring's keypoints with depth within
+  // flat_box_tolerance 1/m of it), the box shows a picture or a static surface, not a person
+  // in front of one: nothing in it is dropped. Keys Screening.rejectFlatBoxes,
+  // flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing (fraction of the box size per side).
+  bool reject_flat_boxes = false;
+  double flat_box_fraction = 0.4;
+  double flat_box_tolerance = 0.01;
+  double flat_box_ring = 0.25;
+  // Box tracking between detections (screening::BoxTracker, beyond the paper): people the
+  // detector misses in a frame keep a box moved by their keypoints' motion. Modes detect and
+  // detect+geometry only. Keys Screening.trackBoxes, trackMaxAge (frames), trackRadius (px),
+  // trackMaxHamming (bits), trackMinMatches; meaning in box_tracker.h.
+  bool track_boxes = false;
+  int track_max_age = 5;
+  double track_radius_px = 40;
+  int track_max_hamming = 50;
+  int track_min_matches = 5;
 
   // Reads Screening.mode, Screening.variant, Screening.varianceThreshold (m^2),
   // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
@@ -94,6 +113,7 @@ struct ScreeningStats {
   int dropped = 0;     // of those, marked dynamic
   int iterations = 0;  // RANSAC iterations summed over boxes
   double ms = 0;       // wall time of screen()
+  int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
 };
 
 // Eq. 8: k = log(1 - P) / log(1 - w^N). Returns +infinity when w <= 0 (no information yet) and
