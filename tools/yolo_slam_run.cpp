@@ -51,6 +51,7 @@ const char* kUsage =
     "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt]\n"
+    "                     [--track-boxes on|off]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -72,10 +73,13 @@ const char* kUsage =
     "  --no-vocabulary    run without BoW: no BoW matching, relocalisation or loop closing\n"
     "  --boxes-from-gt    person boxes from the sequence's boxes.txt (synthetic ground truth)\n"
     "                     instead of running the detector\n"
+    "  --track-boxes B    override Screening.trackBoxes: on carries person boxes over frames\n"
+    "                     where the detector misses them (modes detect, detect+geometry);\n"
+    "                     screening metrics count the boxes actually screened\n"
     "  -h, --help         this text\n";
 
 struct Args {
-  std::string sequence, config, out, model, vocabulary, dynamic_mode;
+  std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes;
   long max_frames = -1;
   bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false;
 };
@@ -97,6 +101,11 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
     else if (s == "--realtime") a.realtime = true;
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
+    else if (s == "--track-boxes") {
+      a.track_boxes = need(i, s);
+      if (a.track_boxes != "on" && a.track_boxes != "off")
+        throw Error("--track-boxes must be on or off (got '" + a.track_boxes + "')");
+    }
     else if (s == "--max-frames") {
       std::string v = need(i, s);
       char* end = nullptr;
@@ -221,6 +230,7 @@ int run(const Args& args) {
   CameraModel cam = CameraModel::load(cfg);
   slam::SystemOptions sys_opt = slam::SystemOptions::load(cfg);
   if (!args.dynamic_mode.empty()) sys_opt.screening.mode = screening::parseDynamicMode(args.dynamic_mode);
+  if (!args.track_boxes.empty()) sys_opt.screening.track_boxes = args.track_boxes == "on";
   const screening::DynamicMode mode = sys_opt.screening.mode;
   const bool needs_boxes = mode == screening::DynamicMode::Detect || mode == screening::DynamicMode::DetectGeometry;
 
@@ -334,7 +344,7 @@ int run(const Args& args) {
         // Retention counts static keypoints inside the boxes this run used (none in modes
         // off/geometry); exact synthetic masks need no ignored border.
         try {
-          metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, p.boxes, 0);
+          metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, system.lastBoxes(), 0);
           ++metrics.frames;
         } catch (const Error& e) {
           std::fprintf(stderr, "\nwarning: %s: %s (frame not evaluated)\n", p.mask_path.c_str(), e.what());
@@ -386,6 +396,8 @@ int run(const Args& args) {
      << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4)
      << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
      << ", \"dropped\": " << s.keypoints_dropped << "}"
+     << ",\n  \"track_boxes\": " << (sys_opt.screening.track_boxes && needs_boxes ? "true" : "false")
+     << ",\n  \"boxes_screened\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
      << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
      << ",\n  \"screening_metrics\": " << metrics.json();
   std::vector<double> et;

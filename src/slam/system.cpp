@@ -43,6 +43,11 @@ System::System(const CameraModel& cam, const SystemOptions& options,
   const features::OrbOptions& orb_opt = options.orb;
   orb_ = std::make_unique<features::OrbExtractor>(orb_opt);
   screener_ = std::make_unique<screening::Screener>(options.screening);
+  const screening::DynamicMode m = options.screening.mode;
+  if (options.screening.track_boxes &&
+      (m == screening::DynamicMode::Detect || m == screening::DynamicMode::DetectGeometry))
+    box_tracker_ = std::make_unique<screening::BoxTracker>(
+        screening::BoxTrackerOptions::from(options.screening));
   auto pyr = std::make_shared<ScalePyramid>(ScalePyramid::make(orb_opt.n_levels, orb_opt.scale_factor));
   map_ = std::make_unique<Map>();
   if (voc_) {
@@ -115,8 +120,19 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   }
   const double extraction_ms = sw.ms();
   sw.restart();
-  screening::ScreeningStats ss = screener_->screen(ff, boxes);
+  detection::Boxes used = boxes;
+  screening::ScreeningStats ss;
+  if (box_tracker_) {
+    std::lock_guard<std::mutex> lk(box_tracker_mutex_);
+    used = box_tracker_->predict(ff, boxes);
+    ss = screener_->screen(ff, used);
+    box_tracker_->observe(ff);
+  } else {
+    ss = screener_->screen(ff, used);
+  }
   const double screening_ms = sw.ms();
+  long n_tracked = 0;
+  for (const auto& b : used) n_tracked += b.tracked ? 1 : 0;
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     stats_.extraction_ms.push_back(extraction_ms);
@@ -124,10 +140,13 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     stats_.keypoints_in_boxes += ss.in_boxes;
     stats_.keypoints_kept += ss.kept;
     stats_.keypoints_dropped += ss.dropped;
+    stats_.boxes_tracked += n_tracked;
+    stats_.boxes_detected += static_cast<long>(used.size()) - n_tracked;
   }
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
     last_frame_ = ff;
+    last_boxes_ = std::move(used);
   }
   return trackFeatures(ff);
 }
@@ -229,6 +248,11 @@ features::FeatureFrame System::lastFrame() const {
   return last_frame_;
 }
 
+detection::Boxes System::lastBoxes() const {
+  std::lock_guard<std::mutex> lk(last_frame_mutex_);
+  return last_boxes_;
+}
+
 void System::recordDetectionTime(double ms) {
   std::lock_guard<std::mutex> lk(stats_mutex_);
   stats_.detection_ms.push_back(ms);
@@ -312,6 +336,7 @@ std::string System::statsJson() const {
     << ",\n  \"global_bundle_adjustments\": " << s.global_bas
     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
     << ", \"dropped\": " << s.keypoints_dropped << "}"
+    << ",\n  \"boxes\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
     << ",\n  \"timings\": {\n    \"extraction\": " << summaryJsonMs(summarize(s.extraction_ms))
     << ",\n    \"screening\": " << summaryJsonMs(summarize(s.screening_ms))
     << ",\n    \"tracking\": " << summaryJsonMs(summarize(s.tracking_ms));

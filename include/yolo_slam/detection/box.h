@@ -14,6 +14,9 @@ struct Box {
   std::string label;
   float score = 0.f;
   cv::Rect2f rect;
+  // True for a box screening::BoxTracker carried over from earlier detections (the detector
+  // missed the object in this frame); score is then the score of the last detection.
+  bool tracked = false;
 };
 using Boxes = std::vector<Box>;
 

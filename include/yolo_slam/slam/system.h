@@ -6,6 +6,7 @@
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/screening/box_tracker.h"
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
@@ -47,6 +48,8 @@ struct SystemStats {
   size_t keyframes_culled = 0;
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
+  // Boxes screened: from the detector, and carried by the BoxTracker (Screening.trackBoxes).
+  long boxes_detected = 0, boxes_tracked = 0;
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
 };
 
@@ -103,6 +106,9 @@ class System {
   // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
   // screener), e.g. for screening metrics against ground truth; empty before the first frame.
   features::FeatureFrame lastFrame() const;
+  // The boxes trackRgbd screened the last frame with: the caller's detections plus the boxes
+  // carried by the BoxTracker (tracked = true); use them for screening metrics.
+  detection::Boxes lastBoxes() const;
   // Blocks until loop closing has processed its queue and any global BA has finished.
   void waitForLoopClosing();
   // (current keyframe id, loop keyframe id) of each loop closed so far.
@@ -115,6 +121,10 @@ class System {
   SlamOptions opt_;
   std::unique_ptr<features::OrbExtractor> orb_;
   std::unique_ptr<screening::Screener> screener_;
+  // Null unless Screening.trackBoxes in mode detect or detect+geometry.
+  std::unique_ptr<screening::BoxTracker> box_tracker_;
+  // Guards box_tracker_ across predict/screen/observe of one frame (taken alone).
+  std::mutex box_tracker_mutex_;
   std::shared_ptr<const vocabulary::Vocabulary> voc_;
   // Declared before map_: the map removes keyframes from it until destroyed.
   std::unique_ptr<vocabulary::KeyFrameDatabase> kfdb_;
@@ -134,6 +144,7 @@ class System {
   // Guards last_frame_ (taken alone, never while holding another of the mutexes above).
   mutable std::mutex last_frame_mutex_;
   features::FeatureFrame last_frame_;
+  detection::Boxes last_boxes_;  // also guarded by last_frame_mutex_
 };
 
 }  // namespace slam

@@ -1,0 +1,180 @@
+#include "yolo_slam/screening/box_tracker.h"
+
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/features/hamming.h"
+#include "yolo_slam/screening/screener.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace yolo_slam {
+namespace screening {
+
+double iou(const cv::Rect2f& a, const cv::Rect2f& b) {
+  const float inter = (a & b).area();
+  const float uni = a.area() + b.area() - inter;
+  return uni > 0 ? inter / uni : 0.0;
+}
+
+BoxTrackerOptions BoxTrackerOptions::from(const ScreeningOptions& s) {
+  BoxTrackerOptions o;
+  o.max_age = s.track_max_age;
+  o.radius_px = s.track_radius_px;
+  o.max_hamming = s.track_max_hamming;
+  o.min_matches = s.track_min_matches;
+  return o;
+}
+
+void BoxTrackerOptions::validate(const std::string& where) const {
+  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
+  if (max_age < 1) bad("trackMaxAge must be >= 1 (frames), got " + std::to_string(max_age));
+  if (!(radius_px > 0) || !std::isfinite(radius_px))
+    bad("trackRadius must be > 0 (pixels), got " + std::to_string(radius_px));
+  if (max_hamming < 0 || max_hamming > 256)
+    bad("trackMaxHamming must be in [0, 256], got " + std::to_string(max_hamming));
+  if (min_matches < 1) bad("trackMinMatches must be >= 1, got " + std::to_string(min_matches));
+  if (!(iou_associate > 0 && iou_associate <= 1))
+    bad("IoU association threshold must be in (0, 1], got " + std::to_string(iou_associate));
+  if (!(covered_fraction > 0 && covered_fraction <= 1))
+    bad("covered fraction must be in (0, 1], got " + std::to_string(covered_fraction));
+}
+
+BoxTracker::BoxTracker(const BoxTrackerOptions& options) : opt_(options) { opt_.validate(); }
+
+bool BoxTracker::displacement(const Track& t, const features::FeatureFrame& frame,
+                              cv::Point2f& d) const {
+  if (t.pts.empty() || frame.descriptors.rows != static_cast<int>(frame.keypoints.size())) return false;
+  const float r2 = static_cast<float>(opt_.radius_px * opt_.radius_px);
+  std::vector<float> dx, dy;
+  dx.reserve(t.pts.size());
+  dy.reserve(t.pts.size());
+  for (size_t k = 0; k < t.pts.size(); ++k) {
+    const cv::Point2f p = t.pts[k];
+    const uint8_t* dk = t.desc.ptr<uint8_t>(static_cast<int>(k));
+    int best = opt_.max_hamming + 1, best_i = -1;
+    for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+      const cv::Point2f q = frame.keypoints[i].pt;
+      const float ex = q.x - p.x, ey = q.y - p.y;
+      if (ex * ex + ey * ey > r2) continue;
+      const int h = features::hammingDistance(dk, frame.descriptors.ptr<uint8_t>(static_cast<int>(i)));
+      if (h < best) {  // strict: the lowest index wins ties (deterministic)
+        best = h;
+        best_i = static_cast<int>(i);
+      }
+    }
+    if (best_i < 0) continue;
+    dx.push_back(frame.keypoints[best_i].pt.x - p.x);
+    dy.push_back(frame.keypoints[best_i].pt.y - p.y);
+  }
+  if (static_cast<int>(dx.size()) < opt_.min_matches) return false;
+  // Median per axis: robust to the wrong matches on repeated texture and to keypoints of the
+  // background that were screened dynamic by mistake.
+  auto median = [](std::vector<float>& v) {
+    const size_t m = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + m, v.end());
+    return v[m];
+  };
+  d = cv::Point2f(median(dx), median(dy));
+  return true;
+}
+
+detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
+                                     const detection::Boxes& detections) {
+  detection::Boxes out = detections;
+  for (auto& b : out) b.tracked = false;
+  const size_t nd = detections.size();
+  std::vector<int> det_track(nd, -1);     // track index associated to each detection
+  std::vector<int> track_det(tracks_.size(), -1);
+
+  // Greedy one-to-one association by decreasing IoU with the track's last box (ties: lower
+  // track id, then lower detection index), so the result does not depend on container order
+  // beyond ids.
+  std::vector<std::tuple<double, size_t, size_t>> pairs;
+  for (size_t t = 0; t < tracks_.size(); ++t)
+    for (size_t j = 0; j < nd; ++j) {
+      const double v = iou(tracks_[t].box.rect, detections[j].rect);
+      if (v >= opt_.iou_associate) pairs.emplace_back(v, t, j);
+    }
+  std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) {
+    if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) > std::get<0>(b);
+    if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
+    return std::get<2>(a) < std::get<2>(b);
+  });
+  for (const auto& p : pairs) {
+    const size_t t = std::get<1>(p), j = std::get<2>(p);
+    if (track_det[t] >= 0 || det_track[j] >= 0) continue;
+    track_det[t] = static_cast<int>(j);
+    det_track[j] = static_cast<int>(t);
+  }
+
+  const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
+  std::vector<Track> kept;
+  kept.reserve(tracks_.size() + nd);
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    Track& tr = tracks_[t];
+    if (track_det[t] >= 0) {
+      tr.box = detections[track_det[t]];
+      tr.box.tracked = false;
+      tr.age = 0;
+      kept.push_back(std::move(tr));
+      continue;
+    }
+    if (++tr.age > opt_.max_age) continue;
+    cv::Point2f d;
+    if (!displacement(tr, frame, d)) continue;
+    cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);
+    const cv::Rect2f visible = frame.width > 0 && frame.height > 0 ? (moved & image) : moved;
+    // Mostly outside the image: the person walked out of view.
+    if (!(visible.area() >= 0.2f * moved.area()) || visible.area() <= 0) continue;
+    // A detection already screens this person (its box changed too much for the IoU test):
+    // no duplicate; the detection's own track carries on.
+    bool covered = false;
+    for (size_t j = 0; j < nd && !covered; ++j)
+      covered = (visible & detections[j].rect).area() >= opt_.covered_fraction * visible.area();
+    if (covered) continue;
+    tr.box.rect = visible;
+    tr.box.tracked = true;
+    out.push_back(tr.box);
+    kept.push_back(std::move(tr));
+  }
+  for (size_t j = 0; j < nd; ++j) {
+    if (det_track[j] >= 0) continue;
+    Track tr;
+    tr.id = next_id_++;
+    tr.box = detections[j];
+    tr.box.tracked = false;
+    kept.push_back(std::move(tr));
+  }
+  std::sort(kept.begin(), kept.end(), [](const Track& a, const Track& b) { return a.id < b.id; });
+  tracks_ = std::move(kept);
+  return out;
+}
+
+void BoxTracker::observe(const features::FeatureFrame& frame) {
+  const bool have_desc = frame.descriptors.rows == static_cast<int>(frame.keypoints.size()) &&
+                         frame.descriptors.cols == 32 && frame.descriptors.type() == CV_8U;
+  for (Track& tr : tracks_) {
+    tr.pts.clear();
+    tr.desc.release();
+    if (!have_desc) continue;
+    const cv::Rect2f& r = tr.box.rect;
+    std::vector<int> idx;
+    for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+      if (i >= frame.dynamic.size() || !frame.dynamic[i]) continue;
+      const cv::Point2f p = frame.keypoints[i].pt;
+      // Only the person's keypoints (screened dynamic): the background inside the box moves
+      // with the camera, not with the person.
+      if (p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height)
+        idx.push_back(static_cast<int>(i));
+    }
+    tr.desc.create(static_cast<int>(idx.size()), 32, CV_8U);
+    for (size_t k = 0; k < idx.size(); ++k) {
+      tr.pts.push_back(frame.keypoints[idx[k]].pt);
+      frame.descriptors.row(idx[k]).copyTo(tr.desc.row(static_cast<int>(k)));
+    }
+  }
+}
+
+}  // namespace screening
+}  // namespace yolo_slam

@@ -1,0 +1,258 @@
+#include "yolo_slam/screening/box_tracker.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/screening/screener.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace yolo_slam;
+using screening::BoxTracker;
+using screening::BoxTrackerOptions;
+
+namespace {
+
+// A person: n textured keypoints inside `box` (fixed random descriptors), plus background
+// keypoints spread over the image with their own descriptors.
+struct Scene {
+  std::vector<cv::Point2f> person, background;
+  cv::Mat person_desc, background_desc;
+};
+
+Scene makeScene(const cv::Rect2f& box, int n_person, int n_background, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> ux(0.f, 1.f);
+  Scene s;
+  for (int i = 0; i < n_person; ++i)
+    s.person.emplace_back(box.x + 5 + ux(rng) * (box.width - 10), box.y + 5 + ux(rng) * (box.height - 10));
+  for (int i = 0; i < n_background; ++i) s.background.emplace_back(ux(rng) * 640, ux(rng) * 480);
+  s.person_desc.create(n_person, 32, CV_8U);
+  s.background_desc.create(n_background, 32, CV_8U);
+  cv::RNG cvrng(seed);  // per-scene RNG: tests do not depend on their order
+  if (n_person > 0) cvrng.fill(s.person_desc, cv::RNG::UNIFORM, 0, 256);
+  if (n_background > 0) cvrng.fill(s.background_desc, cv::RNG::UNIFORM, 0, 256);
+  return s;
+}
+
+// The frame with the person shifted by (dx, dy); keypoints of the person flagged dynamic.
+features::FeatureFrame makeFrame(const Scene& s, float dx, float dy, bool with_person = true) {
+  features::FeatureFrame f;
+  f.width = 640;
+  f.height = 480;
+  std::vector<cv::Mat> rows;
+  if (with_person) {
+    for (size_t i = 0; i < s.person.size(); ++i) {
+      f.keypoints.emplace_back(s.person[i] + cv::Point2f(dx, dy), 7.f);
+      f.dynamic.push_back(1);
+      rows.push_back(s.person_desc.row(static_cast<int>(i)));
+    }
+  }
+  for (size_t i = 0; i < s.background.size(); ++i) {
+    f.keypoints.emplace_back(s.background[i], 7.f);
+    f.dynamic.push_back(0);
+    rows.push_back(s.background_desc.row(static_cast<int>(i)));
+  }
+  cv::vconcat(rows, f.descriptors);
+  f.keypoints_un = f.keypoints;
+  f.depth.assign(f.keypoints.size(), 2.f);
+  f.right_u.assign(f.keypoints.size(), -1.f);
+  return f;
+}
+
+detection::Box personBox(const cv::Rect2f& r) {
+  detection::Box b;
+  b.class_id = 0;
+  b.label = "person";
+  b.score = 0.9f;
+  b.rect = r;
+  return b;
+}
+
+const cv::Rect2f kBox(200, 100, 120, 240);
+
+}  // namespace
+
+TEST(BoxTracker, MissedDetectionGivesBoxMovedByKeypoints) {
+  Scene s = makeScene(kBox, 40, 200, 1);
+  BoxTracker tr(BoxTrackerOptions{});
+  features::FeatureFrame f0 = makeFrame(s, 0, 0);
+  detection::Boxes b0 = tr.predict(f0, {personBox(kBox)});
+  ASSERT_EQ(b0.size(), 1u);
+  EXPECT_FALSE(b0[0].tracked);
+  tr.observe(f0);
+  features::FeatureFrame f1 = makeFrame(s, 12, -7);
+  detection::Boxes b1 = tr.predict(f1, {});
+  ASSERT_EQ(b1.size(), 1u);
+  EXPECT_TRUE(b1[0].tracked);
+  EXPECT_EQ(b1[0].label, "person");
+  EXPECT_NEAR(b1[0].rect.x, kBox.x + 12, 0.5);
+  EXPECT_NEAR(b1[0].rect.y, kBox.y - 7, 0.5);
+  EXPECT_NEAR(b1[0].rect.width, kBox.width, 1e-3);
+  // Keeps following over further missed frames.
+  tr.observe(f1);
+  features::FeatureFrame f2 = makeFrame(s, 20, -10);
+  detection::Boxes b2 = tr.predict(f2, {});
+  ASSERT_EQ(b2.size(), 1u);
+  EXPECT_NEAR(b2[0].rect.x, kBox.x + 20, 0.5);
+  EXPECT_NEAR(b2[0].rect.y, kBox.y - 10, 0.5);
+}
+
+TEST(BoxTracker, BackgroundKeypointsNotScreenedDoNotDragTheBox) {
+  // Static background keypoints inside the box (dynamic = 0) stay put; only the person moves.
+  Scene s = makeScene(kBox, 30, 0, 2);
+  Scene bg = makeScene(kBox, 30, 0, 3);  // "person" keypoints of bg used as static in-box texture
+  BoxTracker tr(BoxTrackerOptions{});
+  auto frame = [&](float dx) {
+    features::FeatureFrame f = makeFrame(s, dx, 0);
+    for (int i = 0; i < 30; ++i) {
+      f.keypoints.emplace_back(bg.person[i], 7.f);
+      f.dynamic.push_back(0);
+    }
+    cv::vconcat(f.descriptors, bg.person_desc, f.descriptors);
+    return f;
+  };
+  features::FeatureFrame f0 = frame(0);
+  tr.predict(f0, {personBox(kBox)});
+  tr.observe(f0);
+  detection::Boxes b1 = tr.predict(frame(15), {});
+  ASSERT_EQ(b1.size(), 1u);
+  EXPECT_NEAR(b1[0].rect.x, kBox.x + 15, 0.5);
+}
+
+TEST(BoxTracker, TrackDroppedAfterMaxAge) {
+  Scene s = makeScene(kBox, 40, 100, 4);
+  BoxTrackerOptions o;
+  o.max_age = 3;
+  BoxTracker tr(o);
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  tr.predict(f, {personBox(kBox)});
+  tr.observe(f);
+  for (int k = 1; k <= 3; ++k) {
+    f = makeFrame(s, 2.f * k, 0);
+    EXPECT_EQ(tr.predict(f, {}).size(), 1u) << "frame " << k;
+    tr.observe(f);
+  }
+  f = makeFrame(s, 8, 0);
+  EXPECT_TRUE(tr.predict(f, {}).empty());
+  EXPECT_EQ(tr.numTracks(), 0u);
+}
+
+TEST(BoxTracker, DetectionRefreshesTrackWithoutDuplicate) {
+  Scene s = makeScene(kBox, 40, 100, 5);
+  BoxTrackerOptions o;
+  o.max_age = 2;
+  BoxTracker tr(o);
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  tr.predict(f, {personBox(kBox)});
+  tr.observe(f);
+  f = makeFrame(s, 5, 0);
+  ASSERT_EQ(tr.predict(f, {}).size(), 1u);
+  tr.observe(f);
+  // Detected again (slightly different box): only the detection, one track.
+  f = makeFrame(s, 10, 0);
+  cv::Rect2f det(kBox.x + 8, kBox.y + 3, kBox.width - 4, kBox.height + 6);
+  detection::Boxes b = tr.predict(f, {personBox(det)});
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_FALSE(b[0].tracked);
+  EXPECT_EQ(b[0].rect, det);
+  EXPECT_EQ(tr.numTracks(), 1u);
+  tr.observe(f);
+  // The age restarted: two more missed frames are carried (max_age 2), the third is not.
+  for (int k = 1; k <= 2; ++k) {
+    f = makeFrame(s, 10.f + k, 0);
+    EXPECT_EQ(tr.predict(f, {}).size(), 1u) << "frame " << k;
+    tr.observe(f);
+  }
+  EXPECT_TRUE(tr.predict(makeFrame(s, 13, 0), {}).empty());
+}
+
+TEST(BoxTracker, NoMatchDropsTrack) {
+  Scene s = makeScene(kBox, 40, 100, 6);
+  BoxTracker tr(BoxTrackerOptions{});
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  tr.predict(f, {personBox(kBox)});
+  tr.observe(f);
+  // The person is gone (only the background is seen).
+  EXPECT_TRUE(tr.predict(makeFrame(s, 0, 0, false), {}).empty());
+  EXPECT_EQ(tr.numTracks(), 0u);
+  // Moved farther than the search radius: no match either.
+  BoxTracker tr2(BoxTrackerOptions{});
+  tr2.predict(f, {personBox(kBox)});
+  tr2.observe(f);
+  EXPECT_TRUE(tr2.predict(makeFrame(s, 100, 0), {}).empty());
+}
+
+TEST(BoxTracker, TwoPeopleOneDetectedOneTracked) {
+  const cv::Rect2f a(50, 100, 100, 200), b(400, 120, 100, 200);
+  Scene sa = makeScene(a, 30, 0, 7), sb = makeScene(b, 30, 100, 8);
+  auto frame = [&](float dxa, float dxb) {
+    features::FeatureFrame fa = makeFrame(sa, dxa, 0), fb = makeFrame(sb, dxb, 0);
+    fa.keypoints.insert(fa.keypoints.end(), fb.keypoints.begin(), fb.keypoints.end());
+    fa.dynamic.insert(fa.dynamic.end(), fb.dynamic.begin(), fb.dynamic.end());
+    cv::vconcat(fa.descriptors, fb.descriptors, fa.descriptors);
+    return fa;
+  };
+  BoxTracker tr(BoxTrackerOptions{});
+  features::FeatureFrame f = frame(0, 0);
+  EXPECT_EQ(tr.predict(f, {personBox(a), personBox(b)}).size(), 2u);
+  tr.observe(f);
+  f = frame(4, -9);
+  cv::Rect2f a1(a.x + 4, a.y, a.width, a.height);
+  detection::Boxes out = tr.predict(f, {personBox(a1)});
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_FALSE(out[0].tracked);
+  EXPECT_TRUE(out[1].tracked);
+  EXPECT_NEAR(out[1].rect.x, b.x - 9, 0.5);
+  // Same input, fresh tracker: same output (deterministic).
+  BoxTracker tr2(BoxTrackerOptions{});
+  features::FeatureFrame g = frame(0, 0);
+  tr2.predict(g, {personBox(a), personBox(b)});
+  tr2.observe(g);
+  detection::Boxes out2 = tr2.predict(frame(4, -9), {personBox(a1)});
+  ASSERT_EQ(out2.size(), 2u);
+  EXPECT_EQ(out2[1].rect, out[1].rect);
+}
+
+TEST(BoxTracker, BoxLeavingTheImageIsDropped) {
+  const cv::Rect2f r(560, 100, 70, 200);
+  Scene s = makeScene(r, 40, 50, 9);
+  BoxTrackerOptions o;
+  o.radius_px = 100;
+  BoxTracker tr(o);
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  tr.predict(f, {personBox(r)});
+  tr.observe(f);
+  // Moved 70 px right: only 10 px of 70 remain inside the 640-px image (keypoints clipped).
+  features::FeatureFrame g = makeFrame(s, 70, 0);
+  EXPECT_TRUE(tr.predict(g, {}).empty());
+}
+
+TEST(BoxTracker, OptionsValidatedAndLoaded) {
+  BoxTrackerOptions o;
+  o.max_age = 0;
+  EXPECT_THROW(BoxTracker{o}, Error);
+  o = BoxTrackerOptions{};
+  o.radius_px = -1;
+  EXPECT_THROW(BoxTracker{o}, Error);
+  Config cfg = Config::fromString(
+      "%YAML:1.0\nScreening.trackBoxes: 1\nScreening.trackMaxAge: 7\nScreening.trackRadius: 25.5\n"
+      "Screening.trackMaxHamming: 60\nScreening.trackMinMatches: 3\n",
+      "cfg.yaml");
+  screening::ScreeningOptions so = screening::ScreeningOptions::load(cfg);
+  EXPECT_TRUE(so.track_boxes);
+  BoxTrackerOptions l = BoxTrackerOptions::from(so);
+  EXPECT_EQ(l.max_age, 7);
+  EXPECT_DOUBLE_EQ(l.radius_px, 25.5);
+  EXPECT_EQ(l.max_hamming, 60);
+  EXPECT_EQ(l.min_matches, 3);
+  Config bad = Config::fromString("%YAML:1.0\nScreening.trackMaxAge: 0\n", "bad.yaml");
+  try {
+    screening::ScreeningOptions::load(bad);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("trackMaxAge"), std::string::npos) << e.what();
+  }
+}
