@@ -132,5 +132,13 @@ int Frame::countWithDepth() const {
   return n;
 }
 
+std::vector<std::pair<float, int>> Frame::staticByDepth() const {
+  std::vector<std::pair<float, int>> out;
+  for (int i = 0; i < N; ++i)
+    if (depth[i] > 0 && !dynamic[i]) out.emplace_back(depth[i], i);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace slam
 }  // namespace yolo_slam

@@ -200,10 +200,7 @@ void Tracking::updateLastFrame() {
   // ORB-SLAM2 creates temporary close points in the last frame only in localization mode,
   // where no keyframes (and so no new map points) are made.
   if (!localization_only_ || last_kf_frame_id_ == last_.id) return;
-  std::vector<std::pair<float, int>> by_depth;
-  for (int i = 0; i < last_.N; ++i)
-    if (last_.depth[i] > 0 && !last_.dynamic[i]) by_depth.emplace_back(last_.depth[i], i);
-  std::sort(by_depth.begin(), by_depth.end());
+  const std::vector<std::pair<float, int>> by_depth = last_.staticByDepth();
   int n = 0;
   for (const auto& e : by_depth) {
     const int i = e.second;
@@ -613,10 +610,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
   ref_kf_ = kf;
   // Close points with depth become map points right away (ORB-SLAM2 CreateNewKeyFrame):
   // the closest ones first, all those nearer than ThDepth, at least 100.
-  std::vector<std::pair<float, int>> by_depth;
-  for (int i = 0; i < F.N; ++i)
-    if (F.depth[i] > 0 && !F.dynamic[i]) by_depth.emplace_back(F.depth[i], i);
-  std::sort(by_depth.begin(), by_depth.end());
+  const std::vector<std::pair<float, int>> by_depth = F.staticByDepth();
   int n = 0;
   for (const auto& e : by_depth) {
     const int i = e.second;

@@ -74,6 +74,9 @@ class Frame {
   bool usable(size_t i) const { return !dynamic[i]; }
   // Number of keypoints (static) with valid depth.
   int countWithDepth() const;
+  // Static keypoints with valid depth as (depth, index), nearest first: ORB-SLAM2 turns the
+  // closest ones into (temporary or keyframe) map points first.
+  std::vector<std::pair<float, int>> staticByDepth() const;
 
  private:
   std::vector<std::vector<uint32_t>> grid_;  // kGridCols * kGridRows cells of keypoint indices
