@@ -3,10 +3,15 @@
 #include <ros/ros.h>
 
 #include <mutex>
+#include <optional>
 #include <string>
+
+#include <sensor_msgs/CameraInfo.h>
 
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/ros/conversions.h"
 
 namespace yolo_slam {
 namespace ros1 {
@@ -45,6 +50,40 @@ class ErrorThrottle {
   std::mutex mutex_;  // guards last_, last_time_ (callbacks of several threads)
   std::string last_;
   ::ros::WallTime last_time_;
+};
+
+// The camera model a nodelet works with: the last CameraInfo received (bf, ThDepth and the
+// rest from the settings' model), or the settings' own intrinsics when use_camera_info is
+// false. configure() runs in onInit before any callback; update() and get() run on callback
+// threads.
+class CameraSource {
+ public:
+  void configure(const CameraModel& base, bool use_camera_info) {
+    base_ = base;
+    use_camera_info_ = use_camera_info;
+  }
+  // Throws Error (naming `topic`) when the CameraInfo is unusable; the last good one stays.
+  void update(const sensor_msgs::CameraInfo& info, const std::string& topic) {
+    CameraModel cam = cameraFromInfo(info, base_, topic);
+    std::lock_guard<std::mutex> lock(mutex_);
+    cam_ = cam;
+  }
+  // Throws Error when camera_info is wanted and none has arrived on `topic` yet.
+  CameraModel get(const std::string& topic) const {
+    if (!use_camera_info_) return base_;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!cam_)
+      throw Error("no camera_info received on " + topic +
+                  "; publish the camera's CameraInfo or set ~use_camera_info false to take "
+                  "the intrinsics from ~settings");
+    return *cam_;
+  }
+
+ private:
+  CameraModel base_;             // const after configure()
+  bool use_camera_info_ = true;  // const after configure()
+  mutable std::mutex mutex_;     // guards cam_
+  std::optional<CameraModel> cam_;
 };
 
 }  // namespace ros1

@@ -15,7 +15,6 @@
 #include <deque>
 #include <memory>
 #include <mutex>
-#include <optional>
 
 #include "nodelet_common.h"
 #include "yolo_slam/BoundingBoxes.h"
@@ -52,7 +51,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("sync_max_interval", max_interval, 0.05);
     try {
       const Config cfg = loadSettings(pnh);
-      base_cam_ = baseCamera(cfg);
+      camera_.configure(baseCamera(cfg), use_camera_info_);
       orb_ = std::make_unique<features::OrbExtractor>(features::OrbOptions::load(cfg));
       screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
       std::string mode;
@@ -98,9 +97,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
     try {
-      CameraModel cam = cameraFromInfo(*info, base_cam_, info_sub_.getTopic());
-      std::lock_guard<std::mutex> lock(cam_mutex_);
-      cam_ = cam;
+      camera_.update(*info, info_sub_.getTopic());
     } catch (const std::exception& e) {
       NODELET_ERROR_THROTTLE(5.0, "Screening: %s", e.what());
     }
@@ -122,15 +119,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     process(rgb, depth, boxes);
   }
 
-  CameraModel camera() {
-    if (!use_camera_info_) return base_cam_;
-    std::lock_guard<std::mutex> lock(cam_mutex_);
-    if (!cam_)
-      throw Error("no camera_info received on " + info_sub_.getTopic() +
-                  "; publish the camera's CameraInfo or set ~use_camera_info false to take "
-                  "the intrinsics from ~settings");
-    return *cam_;
-  }
+  CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
 
   void process(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const BoundingBoxes::ConstPtr& boxes_msg) {
@@ -229,15 +218,13 @@ class ScreeningNodelet : public nodelet::Nodelet {
   bool use_boxes_ = true, use_camera_info_ = true;
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
-  CameraModel base_cam_;
   std::unique_ptr<features::OrbExtractor> orb_;    // const after onInit (thread-safe extract)
   std::unique_ptr<screening::Screener> screener_;  // const after onInit (screen() is const)
   // Null unless Screening.trackBoxes; stateful, used by the frame callback only (the
   // synchroniser serialises it, like index_).
   std::unique_ptr<screening::BoxTracker> box_tracker_;
 
-  std::mutex cam_mutex_;  // guards cam_ (camera_info callback vs frame callback)
-  std::optional<CameraModel> cam_;
+  CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
   std::mutex stats_mutex_;  // guards the counters below, pending_rgb_ and ms_
   size_t rgb_received_ = 0, synced_ = 0, published_ = 0;

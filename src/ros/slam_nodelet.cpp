@@ -26,7 +26,6 @@
 #include <deque>
 #include <memory>
 #include <mutex>
-#include <optional>
 
 #include "nodelet_common.h"
 #include "yolo_slam/KeypointFrame.h"
@@ -108,7 +107,7 @@ class SlamNodelet : public nodelet::Nodelet {
     try {
       T_bc_ = poseFromParam(b2c, pnh.resolveName("base_to_camera"));
       settings_ = loadSettings(pnh, &settings_path);
-      base_cam_ = baseCamera(settings_);
+      camera_.configure(baseCamera(settings_), use_camera_info_);
       if (!voc_path.empty()) {
         Stopwatch sw;
         vocabulary_ = vocabulary::Vocabulary::load(voc_path);
@@ -158,9 +157,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
     try {
-      CameraModel cam = cameraFromInfo(*info, base_cam_, info_sub_.getTopic());
-      std::lock_guard<std::mutex> lock(cam_mutex_);
-      cam_ = cam;
+      camera_.update(*info, info_sub_.getTopic());
     } catch (const std::exception& e) {
       NODELET_ERROR_THROTTLE(5.0, "Slam: %s", e.what());
     }
@@ -172,15 +169,7 @@ class SlamNodelet : public nodelet::Nodelet {
     while (recent_rgb_.size() > 60) recent_rgb_.pop_front();
   }
 
-  CameraModel camera() {
-    if (!use_camera_info_) return base_cam_;
-    std::lock_guard<std::mutex> lock(cam_mutex_);
-    if (!cam_)
-      throw Error("no camera_info received on " + info_sub_.getTopic() +
-                  "; publish the camera's CameraInfo or set ~use_camera_info false to take "
-                  "the intrinsics from ~settings");
-    return *cam_;
-  }
+  CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
 
   void onFrame(const KeypointFrame::ConstPtr& msg) {
     if (last_index_ != 0 && msg->index > last_index_ + 1) {
@@ -522,11 +511,9 @@ class SlamNodelet : public nodelet::Nodelet {
   std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_;
   Pose T_bc_ = Pose::Identity();  // camera pose in base_link
   Config settings_;
-  CameraModel base_cam_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
-  std::mutex cam_mutex_;  // guards cam_ (camera_info callback vs frame callback)
-  std::optional<CameraModel> cam_;
+  CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
   // Guards system_, localization_only_ and track_ms_ (frame callback, map timer, services,
   // diagnostics). Lock order: system_mutex_ before path_mutex_ (never the reverse).
