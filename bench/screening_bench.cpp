@@ -9,7 +9,10 @@
 // docs/screening.md (interpretations of the paper's 0.43 and a threshold sweep), averaged over
 // S seeds; --variants prints only the table of beyond-paper configurations (nearest cluster,
 // no-depth rules, dilation) and exits. Boxes come from the mask's connected components, or from the YOLO detector with
-// --detector (default model, see detection/detector.h).
+// --detector (default model, see detection/detector.h). --flat: the flat-box rule
+// (screening/flat_box.h): per-box test numbers on the real frame, or the defaults without and
+// with the rule over a tolerance x fraction grid on a --sequence (with --verbose, every box).
+// --help lists the options.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -18,6 +21,7 @@
 #include "yolo_slam/detection/detector.h"
 #include "yolo_slam/features/frame_builder.h"
 #include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/screening/flat_box.h"
 #include "yolo_slam/screening/screener.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -286,9 +290,37 @@ void timing(const RealFrame& rf, int reps) {
   }
 }
 
+// The flat-box test's numbers for one box under the defaults with the rule on: the cluster is
+// what the screener drops in this box alone without the rule.
+void printFlatNumbers(const features::FeatureFrame& frame, const detection::Box& b,
+                      const detection::Boxes& all) {
+  ScreeningOptions o;
+  features::FeatureFrame f = frame;
+  Screener(o).screen(f, {b});
+  std::vector<int> cluster;
+  for (size_t i = 0; i < f.size(); ++i)
+    if (f.dynamic[i]) cluster.push_back(static_cast<int>(i));
+  const float dx = b.rect.width * o.box_dilation, dy = b.rect.height * o.box_dilation;
+  const cv::Rect2f r(b.rect.x - dx, b.rect.y - dy, b.rect.width + 2 * dx, b.rect.height + 2 * dy);
+  FlatBoxOptions fo;
+  fo.ring = o.flat_box_ring;
+  fo.tolerance = o.flat_box_tolerance;
+  fo.fraction = o.flat_box_fraction;
+  std::vector<cv::Rect2f> others;
+  for (const auto& x : all) {
+    if (&x == &b) continue;
+    const float ex = x.rect.width * o.box_dilation, ey = x.rect.height * o.box_dilation;
+    others.emplace_back(x.rect.x - ex, x.rect.y - ey, x.rect.width + 2 * ex, x.rect.height + 2 * ey);
+  }
+  FlatBoxResult res = testFlatBox(frame, r, cluster, fo, others);
+  std::printf("| [%.0f %.0f %.0f x %.0f] | %d (%d) | %d (%d) | %.3f | %s |\n", b.rect.x, b.rect.y,
+              b.rect.width, b.rect.height, res.cluster_points, res.cluster_inliers,
+              res.ring_points, res.ring_on_plane, res.ringFraction(), res.flat ? "yes" : "no");
+}
+
 // A synthetic sequence of yolo_slam_synth: associations.txt, masks/<rgb name>.png and
 // boxes.txt ("rgb_stamp id class x1 y1 x2 y2 visible_fraction", x2/y2 exclusive).
-void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
+void sequenceSweep(const std::string& dir, int stride, bool use_detector, bool flat, bool verbose) {
   std::ifstream assoc(joinPath(dir, "associations.txt"));
   if (!assoc) throw Error(joinPath(dir, "associations.txt") + ": not found; pass a yolo_slam_synth output folder");
   std::map<std::string, detection::Boxes> gt_boxes;
@@ -346,7 +378,24 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
   add("grow 0.1 noDepth nearest", ScreeningVariant::Grow, 0.1, NDR::Nearest);
   add("paper 0.43 noDepth nearest", ScreeningVariant::Paper, 0.43, NDR::Nearest);
   for (const auto& c : variantConfigs()) cfgs.push_back({c.name, c.o});
+  if (flat) {
+    // --flat: the defaults without and with the flat-box rule over a small grid.
+    cfgs.clear();
+    cfgs.push_back({"defaults (flat-box rule off)", ScreeningOptions{}});
+    for (double tol : {0.005, 0.01, 0.02})
+      for (double frac : {0.3, 0.4, 0.5}) {
+        ScreeningOptions o;
+        o.reject_flat_boxes = true;
+        o.flat_box_tolerance = tol;
+        o.flat_box_fraction = frac;
+        char name[96];
+        std::snprintf(name, sizeof name, "flat-box tol %.3f 1/m, fraction %.2f", tol, frac);
+        cfgs.push_back({name, o});
+      }
+  }
   std::vector<ScreeningMetrics> total(cfgs.size());
+  std::vector<int> flat_boxes(cfgs.size(), 0);
+  int n_boxes = 0;
   ScreeningMetrics det_total;
 
   CameraModel cam = CameraModel::load(Config::fromFile(joinPath(dir, "camera.yaml")));
@@ -372,9 +421,15 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
     c.rgb_order = false;  // cv::imread gives BGR
     features::FeatureFrame frame = features::buildFeatureFrame(orb, c, bgr, depth_m, 0.0);
     detection::Boxes boxes = det ? det->detect(bgr) : gt_boxes[rgb_stamp];
+    if (verbose) {
+      for (const auto& b : boxes) {
+        std::printf("%s ", rgb_stamp.c_str());
+        printFlatNumbers(frame, b, boxes);
+      }
+    }
     for (size_t k = 0; k < cfgs.size(); ++k) {
       features::FeatureFrame f = frame;
-      Screener(cfgs[k].o).screen(f, boxes);
+      flat_boxes[k] += Screener(cfgs[k].o).screen(f, boxes).flat_boxes;
       total[k] += evaluateScreening(f, mask, boxes);
     }
     ScreeningOptions d;
@@ -382,24 +437,52 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector) {
     features::FeatureFrame f = frame;
     Screener(d).screen(f, boxes);
     det_total += evaluateScreening(f, mask, boxes);
+    n_boxes += static_cast<int>(boxes.size());
     ++used;
   }
   std::printf("\n%s: %d frames (every %d), %s boxes\n", dir.c_str(), used, stride,
               use_detector ? "detector" : "ground-truth");
-  std::printf("| configuration | dynamic keypoints | dynamic recall | static in boxes | static kept in boxes |\n|---|---|---|---|---|\n");
+  std::printf("| configuration | dynamic keypoints | dynamic recall | static in boxes | static kept in boxes | flat boxes / boxes |\n|---|---|---|---|---|---|\n");
   for (size_t k = 0; k < cfgs.size(); ++k)
-    std::printf("| %s | %d | %.3f | %d | %.3f |\n", cfgs[k].name.c_str(), total[k].dynamic_total,
-                total[k].dynamicRecall(), total[k].static_in_boxes, total[k].staticRetention());
-  std::printf("| mode detect | %d | %.3f | %d | %.3f |\n", det_total.dynamic_total,
+    std::printf("| %s | %d | %.3f | %d | %.3f | %d / %d |\n", cfgs[k].name.c_str(),
+                total[k].dynamic_total, total[k].dynamicRecall(), total[k].static_in_boxes,
+                total[k].staticRetention(), flat_boxes[k], n_boxes);
+  std::printf("| mode detect | %d | %.3f | %d | %.3f | - |\n", det_total.dynamic_total,
               det_total.dynamicRecall(), det_total.static_in_boxes, det_total.staticRetention());
 }
+
+// --flat on the real frame: the flat-box test's numbers for each box (defaults otherwise).
+void realFlat(const RealFrame& rf) {
+  std::printf("\n| box | cluster kp (on plane) | ring kp (on cluster plane) | ring fraction | flat |\n|---|---|---|---|---|\n");
+  for (const auto& b : rf.boxes) printFlatNumbers(rf.frame, b, rf.boxes);
+}
+
+constexpr const char* kUsage =
+    "usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep] [--variants] [--flat]\n"
+    "                       [--border PX]\n"
+    "       screening_bench --sequence DIR [--stride N] [--detector] [--flat] [--verbose]\n"
+    "Screening quality and timing on the real TUM fr3_walking_xyz frame (shared data), or over a\n"
+    "yolo_slam_synth sequence.\n"
+    "  --reps N      timing repetitions per configuration (200)\n"
+    "  --seeds S     RANSAC seeds averaged in --sweep/--variants (20)\n"
+    "  --detector    boxes from the YOLO detector instead of the mask / boxes.txt\n"
+    "  --sweep       nThre interpretation and threshold table\n"
+    "  --variants    beyond-paper configuration table only, then exit\n"
+    "  --flat        flat-box rule: per-box test numbers (real frame) or on/off grid (--sequence)\n"
+    "  --border PX   leave out keypoints within PX of the mask boundary (0)\n"
+    "  --sequence D  synthetic sequence folder (associations.txt, masks/, boxes.txt)\n"
+    "  --stride N    every N-th frame of the sequence (10)\n"
+    "  --verbose     --sequence: the flat-box test's numbers for every box (stamp, box, cluster\n"
+    "                keypoints on its plane, ring keypoints on that plane)\n"
+    "  -h, --help    this text\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
     int reps = 200, seeds = 20;
-    bool use_detector = false, do_sweep = false, do_variants = false;
+    bool use_detector = false, do_sweep = false, do_variants = false, do_flat = false,
+         verbose = false;
     std::string sequence;
     int stride = 10;
     for (int i = 1; i < argc; ++i) {
@@ -408,7 +491,13 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw Error("option " + a + " needs a value");
         return argv[++i];
       };
+      if (a == "-h" || a == "--help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+      }
       if (a == "--reps") reps = std::stoi(next());
+      else if (a == "--flat") do_flat = true;
+      else if (a == "--verbose") verbose = true;
       else if (a == "--seeds") seeds = std::stoi(next());
       else if (a == "--detector") use_detector = true;
       else if (a == "--sweep") do_sweep = true;
@@ -416,15 +505,19 @@ int main(int argc, char** argv) {
       else if (a == "--border") g_border = std::stoi(next());
       else if (a == "--sequence") sequence = next();
       else if (a == "--stride") stride = std::stoi(next());
-      else throw Error("unknown option '" + a + "'; usage: screening_bench [--reps N] [--seeds S] [--detector] [--sweep] [--variants] [--border PX] | --sequence DIR [--stride N] [--detector]");
+      else throw Error("unknown option '" + a + "'; see screening_bench --help");
     }
     if (reps < 1 || seeds < 1 || stride < 1) throw Error("--reps, --seeds and --stride must be >= 1");
     if (!sequence.empty()) {
-      sequenceSweep(sequence, stride, use_detector);
+      sequenceSweep(sequence, stride, use_detector, do_flat, verbose);
       return 0;
     }
     RealFrame rf = loadRealFrame(use_detector);
     printCounts(rf);
+    if (do_flat) {
+      realFlat(rf);
+      return 0;
+    }
     if (do_sweep) sweep(rf, seeds);
     if (do_sweep || do_variants) variantsTable(rf, seeds);
     if (do_variants) return 0;

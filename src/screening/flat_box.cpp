@@ -94,7 +94,8 @@ int fitInverseDepthPlane(const std::vector<cv::Point2f>& pts, const std::vector<
 }
 
 FlatBoxResult testFlatBox(const features::FeatureFrame& frame, const cv::Rect2f& box,
-                          const std::vector<int>& cluster, const FlatBoxOptions& opt) {
+                          const std::vector<int>& cluster, const FlatBoxOptions& opt,
+                          const std::vector<cv::Rect2f>& exclude) {
   FlatBoxResult res;
   std::vector<cv::Point2f> pts;
   std::vector<float> depths;
@@ -120,10 +121,13 @@ FlatBoxResult testFlatBox(const features::FeatureFrame& frame, const cv::Rect2f&
     if (frame.depth[i] <= 0) continue;
     const cv::Point2f& p = frame.keypoints[i].pt;
     if (!in(outer, p) || in(box, p)) continue;
+    bool other = false;
+    for (const cv::Rect2f& e : exclude) other = other || in(e, p);
+    if (other) continue;
     ++res.ring_points;
     if (res.plane.residual(p, frame.depth[i]) < opt.tolerance) ++res.ring_on_plane;
   }
-  res.flat = res.ring_points >= opt.min_points && res.ringFraction() >= opt.fraction;
+  res.flat = res.ring_points >= opt.ring_min_points && res.ringFraction() >= opt.fraction;
   return res;
 }
 

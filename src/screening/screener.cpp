@@ -331,7 +331,10 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
       fo.tolerance = opt_.flat_box_tolerance;
       fo.fraction = opt_.flat_box_fraction;
       fo.seed = opt_.seed + 7919u * region;
-      if (testFlatBox(frame, *region_box, cluster, fo).flat) {
+      std::vector<cv::Rect2f> others;  // region is the box's index in box mode
+      for (size_t k = 0; k < boxes.size(); ++k)
+        if (k != region) others.push_back(dilate(boxes[k].rect, opt_.box_dilation));
+      if (testFlatBox(frame, *region_box, cluster, fo, others).flat) {
         ++st.flat_boxes;
         return;  // a picture or static surface: nothing in this box is dropped
       }

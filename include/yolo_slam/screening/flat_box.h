@@ -33,7 +33,11 @@ struct FlatBoxOptions {
   double ring = 0.25;          // width of the ring around the box, fraction of its width/height
   double tolerance = 0.01;     // inverse-depth residual (1/m) counted as "on the plane"
   double fraction = 0.4;       // ring keypoints (with depth) on the cluster's plane to call it flat
-  int min_points = 8;          // fewer cluster or ring keypoints with depth: never flat
+  int min_points = 8;          // fewer cluster keypoints with depth: never flat
+  // Fewer ring keypoints with depth: never flat. A picture or desk sits in textured
+  // surroundings (43-140 ring keypoints in static_xyz's false detections); a few ring points
+  // (a person clipped by the image border) are too weak a witness (docs/screening.md).
+  int ring_min_points = 20;
   unsigned seed = 0;           // RANSAC seed (deterministic)
 };
 
@@ -58,9 +62,12 @@ int fitInverseDepthPlane(const std::vector<cv::Point2f>& pts, const std::vector<
 // indices into frame of the keypoints it would drop (only those with depth > 0 are used).
 // The ring is `box` grown by options.ring per side minus `box`. Flat when the cluster has a
 // plane (at least half of it within tolerance) and at least options.fraction of the ring's
-// keypoints with depth lie on that plane: the surface continues past the box.
+// keypoints with depth lie on that plane: the surface continues past the box. Ring keypoints
+// inside any of `exclude` (the frame's other boxes) are left out: a second person walking next
+// to the first stands at the same depth and is not the surroundings.
 FlatBoxResult testFlatBox(const features::FeatureFrame& frame, const cv::Rect2f& box,
-                          const std::vector<int>& cluster, const FlatBoxOptions& options);
+                          const std::vector<int>& cluster, const FlatBoxOptions& options,
+                          const std::vector<cv::Rect2f>& exclude = {});
 
 }  // namespace screening
 }  // namespace yolo_slam
