@@ -150,6 +150,28 @@ TEST(FlatBox, PersonCloseToTheWallIsStillAPerson) {
   EXPECT_GT(st.dropped, 100);
 }
 
+TEST(FlatBox, NeighbouringPeopleAreNotTheSurroundings) {
+  // Three people shoulder to shoulder at 2 m (flat cut-outs, 0.5 m apart): the middle box's
+  // ring is half people on its plane; they are other boxes, not a wall continuing past it.
+  const std::vector<cv::Rect2f> people{{119, 4, 134, 459}, kPerson, {387, 4, 134, 459}};
+  auto scene = [&](double u, double v) {
+    for (const auto& r : people)
+      if (r.contains(cv::Point2f(u, v))) return 2.0;
+    return room(u, v);
+  };
+  features::FeatureFrame frame = makeFrame(scene);
+  detection::Boxes boxes;
+  for (const auto& r : people) boxes.push_back(oneBox(r)[0]);
+  std::vector<int> cluster;
+  for (size_t i = 0; i < frame.size(); ++i)
+    if (kPerson.contains(frame.keypoints[i].pt)) cluster.push_back(static_cast<int>(i));
+  EXPECT_TRUE(testFlatBox(frame, kPerson, cluster, FlatBoxOptions{}).flat)
+      << "without the other boxes left out, the neighbours look like a continuing surface";
+  EXPECT_FALSE(testFlatBox(frame, kPerson, cluster, FlatBoxOptions{}, {people[0], people[2]}).flat);
+  ScreeningStats st = Screener(withRule(true)).screen(frame, boxes);
+  EXPECT_EQ(st.flat_boxes, 0);
+}
+
 TEST(FlatBox, TiltedWallIsStillFlat) {
   // Wall turned 50 degrees about the vertical axis (depth 1.7 m to 6 m across the image) with a
   // floor below: the box sits on the wall above the floor line.
