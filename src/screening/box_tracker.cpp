@@ -23,6 +23,7 @@ BoxTrackerOptions BoxTrackerOptions::from(const ScreeningOptions& s) {
   o.radius_px = s.track_radius_px;
   o.max_hamming = s.track_max_hamming;
   o.min_matches = s.track_min_matches;
+  o.min_score = s.track_min_score;
   return o;
 }
 
@@ -34,6 +35,8 @@ void BoxTrackerOptions::validate(const std::string& where) const {
   if (max_hamming < 0 || max_hamming > 256)
     bad("trackMaxHamming must be in [0, 256], got " + std::to_string(max_hamming));
   if (min_matches < 1) bad("trackMinMatches must be >= 1, got " + std::to_string(min_matches));
+  if (!(min_score >= 0 && min_score <= 1))
+    bad("trackMinScore must be in [0, 1], got " + std::to_string(min_score));
   if (!(iou_associate > 0 && iou_associate <= 1))
     bad("IoU association threshold must be in (0, 1], got " + std::to_string(iou_associate));
   if (!(covered_fraction > 0 && covered_fraction <= 1))
@@ -120,7 +123,7 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
       kept.push_back(std::move(tr));
       continue;
     }
-    if (++tr.age > opt_.max_age) continue;
+    if (++tr.age > opt_.max_age || tr.box.score < opt_.min_score) continue;
     cv::Point2f d;
     if (!displacement(tr, frame, d)) continue;
     cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);

@@ -83,6 +83,8 @@ void ScreeningOptions::validate(const std::string& where) const {
     bad("trackMaxHamming must be in [0, 256] (bits), got " + std::to_string(track_max_hamming));
   if (track_min_matches < 1)
     bad("trackMinMatches must be >= 1, got " + std::to_string(track_min_matches));
+  if (!(track_min_score >= 0 && track_min_score <= 1))
+    bad("trackMinScore must be in [0, 1], got " + std::to_string(track_min_score));
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
@@ -137,6 +139,7 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   o.track_radius_px = cfg.getDouble("Screening.trackRadius", o.track_radius_px);
   o.track_max_hamming = cfg.getInt("Screening.trackMaxHamming", o.track_max_hamming);
   o.track_min_matches = cfg.getInt("Screening.trackMinMatches", o.track_min_matches);
+  o.track_min_score = cfg.getDouble("Screening.trackMinScore", o.track_min_score);
   o.validate(file + ": Screening.*");
   return o;
 }

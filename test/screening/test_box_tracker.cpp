@@ -229,6 +229,23 @@ TEST(BoxTracker, BoxLeavingTheImageIsDropped) {
   EXPECT_TRUE(tr.predict(g, {}).empty());
 }
 
+TEST(BoxTracker, LowScoreDetectionNotCarried) {
+  Scene s = makeScene(kBox, 40, 100, 10);
+  BoxTracker tr(BoxTrackerOptions{});  // min_score 0.5
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  detection::Box weak = personBox(kBox);
+  weak.score = 0.35f;
+  tr.predict(f, {weak});
+  tr.observe(f);
+  EXPECT_TRUE(tr.predict(makeFrame(s, 5, 0), {}).empty());
+  BoxTrackerOptions o;
+  o.min_score = 0.3;
+  BoxTracker tr2(o);
+  tr2.predict(f, {weak});
+  tr2.observe(f);
+  EXPECT_EQ(tr2.predict(makeFrame(s, 5, 0), {}).size(), 1u);
+}
+
 TEST(BoxTracker, OptionsValidatedAndLoaded) {
   BoxTrackerOptions o;
   o.max_age = 0;
@@ -238,7 +255,7 @@ TEST(BoxTracker, OptionsValidatedAndLoaded) {
   EXPECT_THROW(BoxTracker{o}, Error);
   Config cfg = Config::fromString(
       "%YAML:1.0\nScreening.trackBoxes: 1\nScreening.trackMaxAge: 7\nScreening.trackRadius: 25.5\n"
-      "Screening.trackMaxHamming: 60\nScreening.trackMinMatches: 3\n",
+      "Screening.trackMaxHamming: 60\nScreening.trackMinMatches: 3\nScreening.trackMinScore: 0.4\n",
       "cfg.yaml");
   screening::ScreeningOptions so = screening::ScreeningOptions::load(cfg);
   EXPECT_TRUE(so.track_boxes);
@@ -247,6 +264,7 @@ TEST(BoxTracker, OptionsValidatedAndLoaded) {
   EXPECT_DOUBLE_EQ(l.radius_px, 25.5);
   EXPECT_EQ(l.max_hamming, 60);
   EXPECT_EQ(l.min_matches, 3);
+  EXPECT_DOUBLE_EQ(l.min_score, 0.4);
   Config bad = Config::fromString("%YAML:1.0\nScreening.trackMaxAge: 0\n", "bad.yaml");
   try {
     screening::ScreeningOptions::load(bad);

@@ -34,6 +34,10 @@ struct BoxTrackerOptions {
   // Fewer matched keypoints than this: the person left the view or is hidden; drop the track
   // rather than trust a median of a handful of matches.
   int min_matches = 5;
+  // Only tracks whose last detection scored at least this are carried. The detector's false
+  // positives on static scenery score low (0.3-0.45 on walking_rpy, people missed in the next
+  // frame scored 0.58-0.92) and carrying them would drop static keypoints for max_age frames.
+  double min_score = 0.5;
   // Detection and track are the same object when the IoU of their boxes is at least this.
   double iou_associate = 0.3;
   // A predicted box whose area is at least this fraction inside a detection is that detection
@@ -41,7 +45,7 @@ struct BoxTrackerOptions {
   double covered_fraction = 0.7;
 
   // The tracker's fields of ScreeningOptions (Screening.trackMaxAge, trackRadius,
-  // trackMaxHamming, trackMinMatches).
+  // trackMaxHamming, trackMinMatches, trackMinScore).
   static BoxTrackerOptions from(const ScreeningOptions& s);
   // Throws yolo_slam::Error (prefixed by `where`) for out-of-range values.
   void validate(const std::string& where = "BoxTrackerOptions") const;

@@ -95,6 +95,7 @@ struct ScreeningOptions {
   double track_radius_px = 40;
   int track_max_hamming = 50;
   int track_min_matches = 5;
+  double track_min_score = 0.5;  // Screening.trackMinScore: last detection's score to carry
 
   // Reads Screening.mode, Screening.variant, Screening.varianceThreshold (m^2),
   // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
