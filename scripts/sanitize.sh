@@ -4,7 +4,8 @@
 # sanitizer report appears in the test output (also one a test might have swallowed, e.g. from a
 # tool it ran as a child process).
 #   scripts/sanitize.sh [address|thread]     (default: address = ASan + UBSan; thread = TSan)
-# Environment: JOBS (make -j, default 2), CTEST_ARGS (extra ctest arguments, e.g. "-R vocabulary").
+# Environment: JOBS (make -j, default 2), CTEST_ARGS (extra ctest arguments, e.g. "-R vocabulary"),
+# SANITIZE_BUILD_DIR (reuse another build folder configured for the same sanitizer).
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -15,7 +16,7 @@ case "$kind" in
   *) echo "error: unknown sanitizer '$kind': use 'address' (ASan+UBSan) or 'thread' (TSan)"; exit 1 ;;
 esac
 
-build="$YS_ROOT/build/sanitize-$kind"
+build="${SANITIZE_BUILD_DIR:-$YS_ROOT/build/sanitize-$kind}"
 supp_dir="$YS_ROOT/test/sanitizers"
 log="$build/sanitize.log"
 mkdir -p "$build" || exit 1
