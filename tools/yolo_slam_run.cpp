@@ -423,6 +423,9 @@ int run(const Args& args) {
                 metrics.frames, percent(metrics.sum.dynamic_dropped, metrics.sum.dynamic_total).c_str(),
                 percent(metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes).c_str(),
                 percent(metrics.sum.static_dropped, metrics.sum.static_total).c_str());
+  if (sys_opt.screening.track_boxes && needs_boxes)
+    std::printf("boxes screened: %ld from the detector, %ld carried by the box tracker\n", s.boxes_detected,
+                s.boxes_tracked);
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;
 }
