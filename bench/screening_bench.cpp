@@ -27,6 +27,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -422,8 +423,15 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector, bool f
     features::FeatureFrame frame = features::buildFeatureFrame(orb, c, bgr, depth_m, 0.0);
     detection::Boxes boxes = det ? det->detect(bgr) : gt_boxes[rgb_stamp];
     if (verbose) {
+      // Each box's best IoU with a ground-truth person box: flat boxes with IoU >= 0.3 are
+      // real people the rule would leave undropped.
       for (const auto& b : boxes) {
-        std::printf("%s ", rgb_stamp.c_str());
+        double iou = 0;
+        for (const auto& g : gt_boxes[rgb_stamp]) {
+          const double inter = (b.rect & g.rect).area();
+          iou = std::max(iou, inter / (b.rect.area() + g.rect.area() - inter));
+        }
+        std::printf("%s iou %.2f ", rgb_stamp.c_str(), iou);
         printFlatNumbers(frame, b, boxes);
       }
     }
