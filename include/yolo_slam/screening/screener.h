@@ -101,7 +101,8 @@ struct ScreeningOptions {
   // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
   // ("dynamic" | "static" | "nearest"), Screening.boxDilation, Screening.growRadius (px),
   // Screening.growDepth (m), Screening.clusterMinFraction, Screening.noDepthRadius (px),
-  // Screening.dilationDepthOnly (bool). Invalid values throw
+  // Screening.dilationDepthOnly (bool), Screening.rejectFlatBoxes (bool), flatBoxFraction,
+  // flatBoxTolerance (1/m), flatBoxRing. Invalid values throw
   // yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // Throws yolo_slam::Error (prefixed by `where`) if a value is out of range.
