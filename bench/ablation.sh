@@ -7,7 +7,8 @@
 #
 # A mode may carry the suffix ":gt" (e.g. "detect+geometry:gt"): person boxes then come from
 # the sequence's ground-truth boxes.txt instead of the detector, which separates detection
-# misses from screening/tracking errors.
+# misses from screening/tracking errors. The suffix ":notrack" runs the mode without box
+# tracking between detections (--track-boxes off: the paper's method as printed).
 # Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
 # OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
 # evaluated with yolo_slam_eval (ATE, RPE delta 1 s); bench/ablation_table.py takes the medians
@@ -54,9 +55,10 @@ while [ $# -gt 0 ]; do
 done
 
 for m in $modes; do
-  case "${m%:gt}" in
+  b="${m%:gt}"; b="${b%:notrack}"
+  case "$b" in
     off|detect|geometry|detect+geometry) ;;
-    *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry (optionally with :gt)" >&2; exit 1 ;;
+    *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry (optionally with :gt or :notrack)" >&2; exit 1 ;;
   esac
 done
 py=/usr/bin/python3
@@ -103,8 +105,10 @@ if [ "$table_only" = 0 ]; then
     fi
     for mode in $modes; do
       base="${mode%:gt}"
+      base="${base%:notrack}"
       extra=()
-      [ "$mode" != "$base" ] && extra=(--boxes-from-gt)
+      case "$mode" in *:gt) extra+=(--boxes-from-gt) ;; esac
+      case "$mode" in *:notrack) extra+=(--track-boxes off) ;; esac
       for r in $(seq 1 "$runs"); do
         dir="$out/runs/$preset/${mode/:/_}/run$r"
         rm -rf "$dir"

@@ -174,15 +174,16 @@ def main():
     for p in sorted(os.listdir(runs_dir)):
         for md in sorted(os.listdir(os.path.join(runs_dir, p))):
             d = os.path.join(runs_dir, p, md)
-            mode = read(os.path.join(d, "run1", "mode.txt"), md.replace("_gt", ":gt"))
+            mode = read(os.path.join(d, "run1", "mode.txt"), md.replace("_gt", ":gt").replace("_notrack", ":notrack"))
             cells[(p, mode)] = Cell(d)
     presets = [p for p in PRESETS if any(k[0] == p for k in cells)]
     presets += sorted({k[0] for k in cells} - set(presets))
-    modes = [m for m in MODES + [x + ":gt" for x in MODES] if any(k[1] == m for k in cells)]
+    modes = [m for m in MODES + [x + ":notrack" for x in MODES] + [x + ":gt" for x in MODES]
+             if any(k[1] == m for k in cells)]
     modes += sorted({k[1] for k in cells} - set(modes))
 
     def label(m):
-        return m[:-3] + " (GT boxes)" if m.endswith(":gt") else m
+        return m.replace(":gt", " (GT boxes)").replace(":notrack", " (no box tracking)")
 
     def frames_of():
         fs = {p: med([c.m(stat("frames")) for (pp, _), c in cells.items() if pp == p and c.ok]) for p in presets}

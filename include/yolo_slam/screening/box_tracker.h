@@ -5,10 +5,11 @@
 // where no detection covers the track, moves its last box by the median displacement of those
 // keypoints, found again by ORB descriptor near their old positions. One tracker per camera
 // stream; deterministic (no RNG, tracks processed in id order).
-// Off by default (Screening.trackBoxes): on the full synthetic runs with the default detector
+// On by default (Screening.trackBoxes): on the full synthetic runs with the default detector
 // it raised dynamic recall by 1-3 points (walking_xyz 88.3 -> 90.2 %, walking_rpy 86.4 -> 89.5 %)
-// and lowered ATE there in single runs, but it also carries a few confident false positives
-// (static_xyz: static keypoints dropped 2.2 -> 3.0 %), so it is not better everywhere yet.
+// and lowered ATE on walking_xyz / walking_half; it also carries a few confident false
+// positives (static_xyz: static keypoints dropped 2.2 -> 3.0 %). The ablation (docs/ablation.md,
+// mode "detect+geometry:notrack") has the medians of both.
 //
 // Per frame:  boxes = tracker.predict(frame, detections);   // before Screener::screen
 //             screener.screen(frame, boxes);

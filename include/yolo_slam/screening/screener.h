@@ -89,8 +89,8 @@ struct ScreeningOptions {
   // Box tracking between detections (screening::BoxTracker, beyond the paper): people the
   // detector misses in a frame keep a box moved by their keypoints' motion. Modes detect and
   // detect+geometry only. Keys Screening.trackBoxes, trackMaxAge (frames), trackRadius (px),
-  // trackMaxHamming (bits), trackMinMatches; meaning in box_tracker.h.
-  bool track_boxes = false;
+  // trackMaxHamming (bits), trackMinMatches, trackMinScore; meaning in box_tracker.h.
+  bool track_boxes = true;
   int track_max_age = 5;
   double track_radius_px = 40;
   int track_max_hamming = 50;
@@ -102,7 +102,8 @@ struct ScreeningOptions {
   // ("dynamic" | "static" | "nearest"), Screening.boxDilation, Screening.growRadius (px),
   // Screening.growDepth (m), Screening.clusterMinFraction, Screening.noDepthRadius (px),
   // Screening.dilationDepthOnly (bool), Screening.rejectFlatBoxes (bool), flatBoxFraction,
-  // flatBoxTolerance (1/m), flatBoxRing. Invalid values throw
+  // flatBoxTolerance (1/m), flatBoxRing, Screening.trackBoxes (bool), trackMaxAge,
+  // trackRadius, trackMaxHamming, trackMinMatches, trackMinScore. Invalid values throw
   // yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // Throws yolo_slam::Error (prefixed by `where`) if a value is out of range.
