@@ -72,6 +72,13 @@ detection::Box personBox(const cv::Rect2f& r) {
 
 const cv::Rect2f kBox(200, 100, 120, 240);
 
+// Frame 0 of `s` with the person detected in `box`: the tracker starts a track.
+void startTrack(BoxTracker& tr, const Scene& s, const cv::Rect2f& box) {
+  features::FeatureFrame f = makeFrame(s, 0, 0);
+  tr.predict(f, {personBox(box)});
+  tr.observe(f);
+}
+
 }  // namespace
 
 TEST(BoxTracker, MissedDetectionGivesBoxMovedByKeypoints) {
@@ -126,9 +133,8 @@ TEST(BoxTracker, TrackDroppedAfterMaxAge) {
   BoxTrackerOptions o;
   o.max_age = 3;
   BoxTracker tr(o);
-  features::FeatureFrame f = makeFrame(s, 0, 0);
-  tr.predict(f, {personBox(kBox)});
-  tr.observe(f);
+  startTrack(tr, s, kBox);
+  features::FeatureFrame f;
   for (int k = 1; k <= 3; ++k) {
     f = makeFrame(s, 2.f * k, 0);
     EXPECT_EQ(tr.predict(f, {}).size(), 1u) << "frame " << k;
@@ -144,9 +150,8 @@ TEST(BoxTracker, DetectionRefreshesTrackWithoutDuplicate) {
   BoxTrackerOptions o;
   o.max_age = 2;
   BoxTracker tr(o);
-  features::FeatureFrame f = makeFrame(s, 0, 0);
-  tr.predict(f, {personBox(kBox)});
-  tr.observe(f);
+  startTrack(tr, s, kBox);
+  features::FeatureFrame f;
   f = makeFrame(s, 5, 0);
   ASSERT_EQ(tr.predict(f, {}).size(), 1u);
   tr.observe(f);
@@ -171,9 +176,8 @@ TEST(BoxTracker, DetectionRefreshesTrackWithoutDuplicate) {
 TEST(BoxTracker, NoMatchDropsTrack) {
   Scene s = makeScene(kBox, 40, 100, 6);
   BoxTracker tr(BoxTrackerOptions{});
-  features::FeatureFrame f = makeFrame(s, 0, 0);
-  tr.predict(f, {personBox(kBox)});
-  tr.observe(f);
+  startTrack(tr, s, kBox);
+  features::FeatureFrame f;
   // The person is gone (only the background is seen).
   EXPECT_TRUE(tr.predict(makeFrame(s, 0, 0, false), {}).empty());
   EXPECT_EQ(tr.numTracks(), 0u);
@@ -221,9 +225,8 @@ TEST(BoxTracker, BoxLeavingTheImageIsDropped) {
   BoxTrackerOptions o;
   o.radius_px = 100;
   BoxTracker tr(o);
-  features::FeatureFrame f = makeFrame(s, 0, 0);
-  tr.predict(f, {personBox(r)});
-  tr.observe(f);
+  startTrack(tr, s, r);
+  features::FeatureFrame f;
   // Moved 70 px right: only 10 px of 70 remain inside the 640-px image (keypoints clipped).
   features::FeatureFrame g = makeFrame(s, 70, 0);
   EXPECT_TRUE(tr.predict(g, {}).empty());
