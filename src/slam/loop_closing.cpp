@@ -158,31 +158,8 @@ std::vector<KeyFramePtr> LoopClosing::detectLoop(const KeyFramePtr& kf) {
   q.exclude = [&excluded](long id) { return excluded.count(id) > 0; };
   const auto hits = db->query(kf->f.bow.bow, 0, q);
 
-  // Group each hit with its 10 best covisibles; keep groups scoring > 0.75 x the best.
-  std::map<long, double> score_of(hits.begin(), hits.end());
-  std::vector<std::pair<double, KeyFramePtr>> groups;
-  double best_acc = 0;
-  for (const auto& h : hits) {
-    KeyFramePtr c = map_.keyFrame(h.first);
-    if (!c || c->bad) continue;
-    double acc = h.second, best = h.second;
-    KeyFramePtr best_kf = c;
-    for (const auto& nb : c->bestCovisibles(10)) {
-      auto it = score_of.find(nb->id);
-      if (it == score_of.end() || nb->bad) continue;
-      acc += it->second;
-      if (it->second > best) {
-        best = it->second;
-        best_kf = nb;
-      }
-    }
-    groups.emplace_back(acc, best_kf);
-    best_acc = std::max(best_acc, acc);
-  }
-  std::vector<KeyFramePtr> cands;
-  std::set<long> seen;
-  for (const auto& g : groups)
-    if (g.first > 0.75 * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
+  // Group each hit with its best covisibles; keep groups scoring > 0.75 x the best.
+  const std::vector<KeyFramePtr> cands = covisibilityGroupCandidates(map_, hits);
 
   // Temporal consistency: a candidate's group (itself + covisibles) must overlap a group that
   // was already consistent for the previous keyframe; `consistency` keyframes in a row.

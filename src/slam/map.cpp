@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
 
 namespace yolo_slam {
 namespace slam {
@@ -159,6 +160,38 @@ void Map::clear() {
   points_.clear();
   origin_.reset();
   if (kfdb_) kfdb_->clear();
+}
+
+std::vector<KeyFramePtr> covisibilityGroupCandidates(const Map& map,
+                                                     const std::vector<std::pair<long, double>>& hits) {
+  std::map<long, double> score_of(hits.begin(), hits.end());
+  std::vector<std::pair<double, KeyFramePtr>> groups;
+  double best_acc = 0;
+  for (const auto& h : hits) {
+    KeyFramePtr kf = map.keyFrame(h.first);
+    if (!kf || kf->bad) continue;
+    double acc = h.second, best_score = h.second;
+    KeyFramePtr best_kf = kf;
+    for (const auto& nb : kf->bestCovisibles(10)) {
+      auto it = score_of.find(nb->id);
+      if (it == score_of.end() || nb->bad) continue;
+      acc += it->second;
+      if (it->second > best_score) {
+        best_score = it->second;
+        best_kf = nb;
+      }
+    }
+    groups.emplace_back(acc, best_kf);
+    best_acc = std::max(best_acc, acc);
+  }
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return a.first > b.first || (a.first == b.first && a.second->id < b.second->id);
+  });
+  std::vector<KeyFramePtr> cands;
+  std::set<long> seen;
+  for (const auto& g : groups)
+    if (g.first > 0.75 * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
+  return cands;
 }
 
 }  // namespace slam

@@ -354,32 +354,7 @@ bool Tracking::relocalize(Frame& F) {
   // represented by its best keyframe.
   const auto hits = db->query(F.bow.bow, 0);
   if (hits.empty()) return false;
-  std::map<long, double> score_of(hits.begin(), hits.end());
-  std::vector<std::pair<double, KeyFramePtr>> groups;
-  double best_acc = 0;
-  for (const auto& h : hits) {
-    KeyFramePtr kf = map_.keyFrame(h.first);
-    if (!kf || kf->bad) continue;
-    double acc = h.second, best_score = h.second;
-    KeyFramePtr best_kf = kf;
-    for (const auto& nb : kf->bestCovisibles(10)) {
-      auto it = score_of.find(nb->id);
-      if (it == score_of.end() || nb->bad) continue;
-      acc += it->second;
-      if (it->second > best_score) {
-        best_score = it->second;
-        best_kf = nb;
-      }
-    }
-    groups.emplace_back(acc, best_kf);
-    best_acc = std::max(best_acc, acc);
-  }
-  std::vector<KeyFramePtr> cands;
-  std::set<long> seen;
-  std::sort(groups.begin(), groups.end(),
-            [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second->id < b.second->id); });
-  for (const auto& g : groups)
-    if (g.first > 0.75 * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
+  std::vector<KeyFramePtr> cands = covisibilityGroupCandidates(map_, hits);
   if (cands.size() > 20) cands.resize(20);
 
   cv::Mat K = (cv::Mat_<double>(3, 3) << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1);

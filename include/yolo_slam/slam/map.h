@@ -94,5 +94,13 @@ class Map {
   std::atomic<long> next_point_id_{0};
 };
 
+// ORB-SLAM2's candidate grouping for loop detection and relocalisation: each bag-of-words hit
+// (keyframe id, score) is grouped with those of its 10 best covisible keyframes that are hits
+// too; a group scores the sum of its hits and is represented by its best-scoring keyframe.
+// Returns the representatives of the groups scoring more than 0.75 x the best group, best
+// group first (ties by keyframe id), each keyframe once. Caller holds map.update_mutex.
+std::vector<KeyFramePtr> covisibilityGroupCandidates(const Map& map,
+                                                     const std::vector<std::pair<long, double>>& hits);
+
 }  // namespace slam
 }  // namespace yolo_slam
