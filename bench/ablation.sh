@@ -5,10 +5,13 @@
 #   bench/ablation.sh [--bin DIR] [--frames N] [--runs R] [--presets "a b c"] [--modes "..."]
 #                     [--out DIR] [--seed S] [--timeout SEC] [--table-only]
 #
-# A mode may carry the suffix ":gt" (e.g. "detect+geometry:gt"): person boxes then come from
-# the sequence's ground-truth boxes.txt instead of the detector, which separates detection
-# misses from screening/tracking errors. The suffix ":notrack" runs the mode without box
-# tracking between detections (--track-boxes off: the paper's method as printed).
+# A mode may carry suffixes, each starting with ':' (e.g. "detect+geometry:gt:noveto"):
+#   :gt       person boxes from the sequence's ground-truth boxes.txt instead of the detector
+#             (separates detection misses from screening/tracking errors)
+#   :notrack  no box tracking between detections (--track-boxes off)
+#   :veto / :noveto   static-box veto on / off (--static-box-veto)
+#   :prop / :noprop   label propagation on / off (--propagate-labels)
+# ":notrack:noveto:noprop" is the paper's method as printed.
 # Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
 # OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
 # evaluated with yolo_slam_eval (ATE, RPE delta 1 s); bench/ablation_table.py takes the medians
@@ -54,12 +57,32 @@ while [ $# -gt 0 ]; do
   esac
 done
 
+# Runner options for a mode's suffixes (in the array `extra`); returns 1 on an unknown suffix.
+suffix_options() {
+  extra=()
+  local rest="${1#"${1%%:*}"}" s
+  local -a parts
+  IFS=':' read -r -a parts <<< "$rest"
+  for s in "${parts[@]}"; do
+    case "$s" in
+      "") ;;
+      gt) extra+=(--boxes-from-gt) ;;
+      notrack) extra+=(--track-boxes off) ;;
+      veto) extra+=(--static-box-veto on) ;;
+      noveto) extra+=(--static-box-veto off) ;;
+      prop) extra+=(--propagate-labels on) ;;
+      noprop) extra+=(--propagate-labels off) ;;
+      *) return 1 ;;
+    esac
+  done
+}
+
 for m in $modes; do
-  b="${m%:gt}"; b="${b%:notrack}"
-  case "$b" in
+  case "${m%%:*}" in
     off|detect|geometry|detect+geometry) ;;
-    *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry (optionally with :gt or :notrack)" >&2; exit 1 ;;
+    *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3
@@ -104,13 +127,10 @@ if [ "$table_only" = 0 ]; then
       fi
     fi
     for mode in $modes; do
-      base="${mode%:gt}"
-      base="${base%:notrack}"
-      extra=()
-      case "$mode" in *:gt) extra+=(--boxes-from-gt) ;; esac
-      case "$mode" in *:notrack) extra+=(--track-boxes off) ;; esac
+      base="${mode%%:*}"
+      suffix_options "$mode"
       for r in $(seq 1 "$runs"); do
-        dir="$out/runs/$preset/${mode/:/_}/run$r"
+        dir="$out/runs/$preset/${mode//:/_}/run$r"
         rm -rf "$dir"
         mkdir -p "$dir"
         echo "$mode" > "$dir/mode.txt"

@@ -182,8 +182,13 @@ def main():
              if any(k[1] == m for k in cells)]
     modes += sorted({k[1] for k in cells} - set(modes))
 
+    suffix_names = {"gt": "GT boxes", "notrack": "no box tracking", "veto": "static-box veto",
+                    "noveto": "no static-box veto", "prop": "label propagation",
+                    "noprop": "no label propagation"}
+
     def label(m):
-        return m.replace(":gt", " (GT boxes)").replace(":notrack", " (no box tracking)")
+        base, *sfx = m.split(":")
+        return base + (" (" + ", ".join(suffix_names.get(x, x) for x in sfx) + ")" if sfx else "")
 
     def frames_of():
         fs = {p: med([c.m(stat("frames")) for (pp, _), c in cells.items() if pp == p and c.ok]) for p in presets}

@@ -431,7 +431,7 @@ void sequenceSweep(const std::string& dir, int stride, bool use_detector, bool f
           const double inter = (b.rect & g.rect).area();
           iou = std::max(iou, inter / (b.rect.area() + g.rect.area() - inter));
         }
-        std::printf("%s iou %.2f ", rgb_stamp.c_str(), iou);
+        std::printf("%s score %.2f iou %.2f ", rgb_stamp.c_str(), b.score, iou);
         printFlatNumbers(frame, b, boxes);
       }
     }

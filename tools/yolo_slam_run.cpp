@@ -51,14 +51,17 @@ const char* kUsage =
     "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt]\n"
-    "                     [--track-boxes on|off]\n"
+    "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
+    "                     [--static-box-veto on|off]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
-    "kept / dropped). On a synthetic sequence (DIR/masks/, from yolo_slam_synth) stats.json also\n"
-    "gets screening_metrics: recall of the keypoints on people's masks and retention of the\n"
-    "static keypoints inside the boxes. Ctrl-C (or SIGTERM) stops at the next frame and still\n"
-    "writes everything (exit code 130); a second Ctrl-C quits at once without writing.\n"
+    "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
+    "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). On a synthetic sequence\n"
+    "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
+    "keypoints on people's masks and retention of the static keypoints inside the boxes.\n"
+    "Ctrl-C (or SIGTERM) stops at the next frame and still writes everything (exit code 130); a\n"
+    "second Ctrl-C quits at once without writing.\n"
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
     "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
@@ -76,10 +79,16 @@ const char* kUsage =
     "  --track-boxes B    override Screening.trackBoxes: on carries person boxes over frames\n"
     "                     where the detector misses them (modes detect, detect+geometry);\n"
     "                     screening metrics count the boxes actually screened\n"
+    "  --propagate-labels B  override Screening.propagateLabels: on marks keypoints matching a\n"
+    "                     moving dynamic keypoint of the previous frame dynamic (every mode\n"
+    "                     but off)\n"
+    "  --static-box-veto B  override Screening.staticBoxVeto: on keeps the keypoints of a box\n"
+    "                     whose dropped keypoints all sit where static points would be\n"
     "  -h, --help         this text\n";
 
 struct Args {
-  std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes;
+  std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes,
+      propagate_labels, static_box_veto;
   long max_frames = -1;
   bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false;
 };
@@ -101,7 +110,15 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
     else if (s == "--realtime") a.realtime = true;
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
-    else if (s == "--track-boxes") {
+    else if (s == "--propagate-labels") {
+      a.propagate_labels = need(i, s);
+      if (a.propagate_labels != "on" && a.propagate_labels != "off")
+        throw Error("--propagate-labels must be on or off (got '" + a.propagate_labels + "')");
+    } else if (s == "--static-box-veto") {
+      a.static_box_veto = need(i, s);
+      if (a.static_box_veto != "on" && a.static_box_veto != "off")
+        throw Error("--static-box-veto must be on or off (got '" + a.static_box_veto + "')");
+    } else if (s == "--track-boxes") {
       a.track_boxes = need(i, s);
       if (a.track_boxes != "on" && a.track_boxes != "off")
         throw Error("--track-boxes must be on or off (got '" + a.track_boxes + "')");
@@ -200,6 +217,11 @@ struct MetricsAccumulator {
     os << "{\"frames\": " << frames << ", \"dynamic_keypoints\": " << sum.dynamic_total
        << ", \"dropped\": " << sum.dynamic_dropped
        << ", \"dynamic_recall\": " << jsonRatio(sum.dynamic_dropped, sum.dynamic_total)
+       << ", \"dynamic_outside_boxes\": " << sum.dynamic_outside_boxes
+       << ", \"dynamic_outside_dropped\": " << sum.dynamic_outside_dropped
+       << ", \"dynamic_recall_in_boxes\": "
+       << jsonRatio(sum.dynamic_dropped - sum.dynamic_outside_dropped,
+                    sum.dynamic_total - sum.dynamic_outside_boxes)
        << ", \"static_in_boxes\": " << sum.static_in_boxes << ", \"kept\": " << sum.static_in_boxes_kept
        << ", \"static_retention\": " << jsonRatio(sum.static_in_boxes_kept, sum.static_in_boxes)
        << ", \"static_keypoints\": " << sum.static_total << ", \"static_dropped\": " << sum.static_dropped
@@ -231,6 +253,8 @@ int run(const Args& args) {
   slam::SystemOptions sys_opt = slam::SystemOptions::load(cfg);
   if (!args.dynamic_mode.empty()) sys_opt.screening.mode = screening::parseDynamicMode(args.dynamic_mode);
   if (!args.track_boxes.empty()) sys_opt.screening.track_boxes = args.track_boxes == "on";
+  if (!args.propagate_labels.empty()) sys_opt.screening.propagate_labels = args.propagate_labels == "on";
+  if (!args.static_box_veto.empty()) sys_opt.screening.static_box_veto = args.static_box_veto == "on";
   const screening::DynamicMode mode = sys_opt.screening.mode;
   const bool needs_boxes = mode == screening::DynamicMode::Detect || mode == screening::DynamicMode::DetectGeometry;
 
@@ -321,6 +345,13 @@ int run(const Args& args) {
   Stopwatch total;
   const auto wall0 = std::chrono::steady_clock::now();
   const double stamp0 = n ? seq.frames()[0].rgb_stamp : 0;
+  // Every box screened, per frame, in the synthetic boxes.txt format: to inspect the detector
+  // and the box tracker offline, or to score them against the ground truth.
+  std::ofstream boxes_out;
+  if (needs_boxes) {
+    boxes_out.open(joinPath(args.out, "boxes_screened.txt"));
+    boxes_out << "# rgb_stamp index label x1 y1 x2 y2 score tracked\n";
+  }
   std::future<Prepared> next;
   if (n > 0) next = std::async(std::launch::async, prepare, size_t{0});
   for (size_t i = 0; i < n && !g_stop; ++i) {
@@ -340,6 +371,16 @@ int run(const Args& args) {
       slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
       if (r.state != slam::TrackingState::Ok) ++lost_reports;
       ++processed;
+      if (boxes_out.is_open()) {
+        int k = 0;
+        char line[160];
+        for (const auto& b : system.lastBoxes()) {
+          std::snprintf(line, sizeof line, "%.6f %d %s %.1f %.1f %.1f %.1f %.3f %d\n", p.stamp, k++,
+                        b.label.empty() ? "person" : b.label.c_str(), b.rect.x, b.rect.y,
+                        b.rect.x + b.rect.width, b.rect.y + b.rect.height, b.score, b.tracked ? 1 : 0);
+          boxes_out << line;
+        }
+      }
       if (!p.mask.empty()) {
         // Retention counts static keypoints inside the boxes this run used (none in modes
         // off/geometry); exact synthetic masks need no ignored border.
@@ -395,8 +436,17 @@ int run(const Args& args) {
      << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
      << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4)
      << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-     << ", \"dropped\": " << s.keypoints_dropped << "}"
+     << ", \"dropped\": " << s.keypoints_dropped << ", \"propagated\": " << s.keypoints_propagated
+     << ", \"vetoed\": " << s.keypoints_vetoed << "}"
+     << ",\n  \"temporal\": {\"matched\": " << s.temporal_matched
+     << ", \"static_consistent\": " << s.temporal_static_consistent
+     << ", \"motion_frames\": " << s.temporal_motion_frames
+     << ", \"boxes_vetoed\": " << s.boxes_vetoed << "}"
      << ",\n  \"track_boxes\": " << (sys_opt.screening.track_boxes && needs_boxes ? "true" : "false")
+     << ",\n  \"propagate_labels\": "
+     << (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off ? "true" : "false")
+     << ",\n  \"static_box_veto\": "
+     << (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off ? "true" : "false")
      << ",\n  \"boxes_screened\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
      << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
      << ",\n  \"screening_metrics\": " << metrics.json();
@@ -426,6 +476,14 @@ int run(const Args& args) {
   if (sys_opt.screening.track_boxes && needs_boxes)
     std::printf("boxes screened: %ld from the detector, %ld carried by the box tracker\n", s.boxes_detected,
                 s.boxes_tracked);
+  if (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off)
+    std::printf("label propagation marked %ld keypoints dynamic\n", s.keypoints_propagated);
+  if (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off)
+    std::printf("static-box veto: %ld boxes left alone, %ld screened keypoints kept\n",
+                s.boxes_vetoed, s.keypoints_vetoed);
+  if (metrics.frames > 0)
+    std::printf("dynamic keypoints outside every box: %s dropped\n",
+                percent(metrics.sum.dynamic_outside_dropped, metrics.sum.dynamic_outside_boxes).c_str());
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;
 }

@@ -24,7 +24,7 @@
 #include "yolo_slam/features/frame_builder.h"
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/ros/conversions.h"
-#include "yolo_slam/screening/box_tracker.h"
+#include "yolo_slam/screening/pipeline.h"
 #include "yolo_slam/screening/screener.h"
 
 namespace yolo_slam {
@@ -56,13 +56,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
       screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
       std::string mode;
       if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
-      screener_ = std::make_unique<screening::Screener>(sopt);
-      // As System::trackRgbd: boxes carried over missed detections in the detect modes only.
-      if (use_boxes_ && sopt.track_boxes &&
-          (sopt.mode == screening::DynamicMode::Detect ||
-           sopt.mode == screening::DynamicMode::DetectGeometry))
-        box_tracker_ = std::make_unique<screening::BoxTracker>(
-            screening::BoxTrackerOptions::from(sopt));
+      // As System::trackRgbd; without the detector's topic there are no boxes to track.
+      if (!use_boxes_) sopt.track_boxes = false;
+      screening_ = std::make_unique<screening::ScreeningPipeline>(sopt);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
                    orb_->options().n_features, screening::toString(sopt.mode).c_str(),
                    use_boxes_ ? "rgb+depth+boxes" : "rgb+depth (no detector)", queue_size);
@@ -158,9 +154,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
           features::buildFeatureFrame(*orb_, cam, image, depth_m, rgb->header.stamp.toSec());
       detection::Boxes boxes;
       if (boxes_msg) boxes = boxesFromMsg(boxes_msg->boxes);
-      if (box_tracker_) boxes = box_tracker_->predict(frame, boxes);  // + carried boxes
-      screener_->screen(frame, boxes);
-      if (box_tracker_) box_tracker_->observe(frame);
+      boxes = screening_->process(frame, boxes, cam).boxes;  // + boxes carried by the tracker
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;
@@ -219,10 +213,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
   std::unique_ptr<features::OrbExtractor> orb_;    // const after onInit (thread-safe extract)
-  std::unique_ptr<screening::Screener> screener_;  // const after onInit (screen() is const)
-  // Null unless Screening.trackBoxes; stateful, used by the frame callback only (the
-  // synchroniser serialises it, like index_).
-  std::unique_ptr<screening::BoxTracker> box_tracker_;
+  // Box tracking, Algorithm 1, label propagation: stateful, used by the frame callback only
+  // (the synchroniser serialises it, like index_).
+  std::unique_ptr<screening::ScreeningPipeline> screening_;
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 

@@ -1,7 +1,7 @@
 #include "yolo_slam/screening/box_tracker.h"
 
 #include "yolo_slam/common/error.h"
-#include "yolo_slam/features/hamming.h"
+#include "yolo_slam/features/match_near.h"
 #include "yolo_slam/screening/screener.h"
 
 #include <algorithm>
@@ -47,25 +47,14 @@ BoxTracker::BoxTracker(const BoxTrackerOptions& options) : opt_(options) { opt_.
 
 bool BoxTracker::displacement(const Track& t, const features::FeatureFrame& frame,
                               cv::Point2f& d) const {
-  if (t.pts.empty() || frame.descriptors.rows != static_cast<int>(frame.keypoints.size())) return false;
-  const float r2 = static_cast<float>(opt_.radius_px * opt_.radius_px);
+  if (t.pts.empty()) return false;
   std::vector<float> dx, dy;
   dx.reserve(t.pts.size());
   dy.reserve(t.pts.size());
   for (size_t k = 0; k < t.pts.size(); ++k) {
     const cv::Point2f p = t.pts[k];
-    const uint8_t* dk = t.desc.ptr<uint8_t>(static_cast<int>(k));
-    int best = opt_.max_hamming + 1, best_i = -1;
-    for (size_t i = 0; i < frame.keypoints.size(); ++i) {
-      const cv::Point2f q = frame.keypoints[i].pt;
-      const float ex = q.x - p.x, ey = q.y - p.y;
-      if (ex * ex + ey * ey > r2) continue;
-      const int h = features::hammingDistance(dk, frame.descriptors.ptr<uint8_t>(static_cast<int>(i)));
-      if (h < best) {  // strict: the lowest index wins ties (deterministic)
-        best = h;
-        best_i = static_cast<int>(i);
-      }
-    }
+    const int best_i = features::bestMatchNear(frame, p, t.desc.ptr<uint8_t>(static_cast<int>(k)),
+                                               opt_.radius_px, opt_.max_hamming);
     if (best_i < 0) continue;
     dx.push_back(frame.keypoints[best_i].pt.x - p.x);
     dy.push_back(frame.keypoints[best_i].pt.y - p.y);

@@ -1,5 +1,7 @@
 #include "yolo_slam/screening/screener.h"
+#include "yolo_slam/screening/box_tracker.h"
 #include "yolo_slam/screening/flat_box.h"
+#include "yolo_slam/screening/temporal.h"
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -75,16 +77,9 @@ void ScreeningOptions::validate(const std::string& where) const {
     bad("flatBoxTolerance must be > 0 (1/m, inverse depth), got " + std::to_string(flat_box_tolerance));
   if (!(flat_box_ring > 0 && flat_box_ring <= 2))
     bad("flatBoxRing must be in (0, 2] (fraction of the box size), got " + std::to_string(flat_box_ring));
-  if (track_max_age < 1)
-    bad("trackMaxAge must be >= 1 (frames), got " + std::to_string(track_max_age));
-  if (!(track_radius_px > 0) || !std::isfinite(track_radius_px))
-    bad("trackRadius must be > 0 (pixels), got " + std::to_string(track_radius_px));
-  if (track_max_hamming < 0 || track_max_hamming > 256)
-    bad("trackMaxHamming must be in [0, 256] (bits), got " + std::to_string(track_max_hamming));
-  if (track_min_matches < 1)
-    bad("trackMinMatches must be >= 1, got " + std::to_string(track_min_matches));
-  if (!(track_min_score >= 0 && track_min_score <= 1))
-    bad("trackMinScore must be in [0, 1], got " + std::to_string(track_min_score));
+  // The tracker's and the temporal evidence's own checks, with the same key names.
+  BoxTrackerOptions::from(*this).validate(where);
+  TemporalOptions::from(*this).validate(where);
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
@@ -140,6 +135,17 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   o.track_max_hamming = cfg.getInt("Screening.trackMaxHamming", o.track_max_hamming);
   o.track_min_matches = cfg.getInt("Screening.trackMinMatches", o.track_min_matches);
   o.track_min_score = cfg.getDouble("Screening.trackMinScore", o.track_min_score);
+  o.propagate_labels = cfg.getBool("Screening.propagateLabels", o.propagate_labels);
+  o.propagate_max_age = cfg.getInt("Screening.propagateMaxAge", o.propagate_max_age);
+  o.static_box_veto = cfg.getBool("Screening.staticBoxVeto", o.static_box_veto);
+  o.static_box_fraction = cfg.getDouble("Screening.staticBoxFraction", o.static_box_fraction);
+  o.static_box_min_points = cfg.getInt("Screening.staticBoxMinPoints", o.static_box_min_points);
+  o.temporal_radius_px = cfg.getDouble("Screening.temporalRadius", o.temporal_radius_px);
+  o.temporal_max_hamming = cfg.getInt("Screening.temporalMaxHamming", o.temporal_max_hamming);
+  o.temporal_max_depth_change_m =
+      cfg.getDouble("Screening.temporalMaxDepthChange", o.temporal_max_depth_change_m);
+  o.temporal_static_tolerance_px =
+      cfg.getDouble("Screening.temporalStaticTolerance", o.temporal_static_tolerance_px);
   o.validate(file + ": Screening.*");
   return o;
 }
@@ -264,8 +270,6 @@ void Screener::grow(const std::vector<cv::Point2f>& pts, const std::vector<float
   }
 }
 
-namespace {
-
 cv::Rect2f dilate(const cv::Rect2f& r, double f) {
   const float dx = static_cast<float>(r.width * f), dy = static_cast<float>(r.height * f);
   return {r.x - dx, r.y - dy, r.width + 2 * dx, r.height + 2 * dy};
@@ -274,8 +278,6 @@ cv::Rect2f dilate(const cv::Rect2f& r, double f) {
 bool inside(const cv::Rect2f& r, const cv::Point2f& p) {
   return p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height;
 }
-
-}  // namespace
 
 ScreeningStats Screener::screen(features::FeatureFrame& frame,
                                 const detection::Boxes& boxes) const {
@@ -428,6 +430,11 @@ double ScreeningMetrics::dynamicRecall() const {
   return dynamic_total > 0 ? static_cast<double>(dynamic_dropped) / dynamic_total : 1.0;
 }
 
+double ScreeningMetrics::dynamicRecallInBoxes() const {
+  const int n = dynamic_total - dynamic_outside_boxes;
+  return n > 0 ? static_cast<double>(dynamic_dropped - dynamic_outside_dropped) / n : 1.0;
+}
+
 double ScreeningMetrics::staticRetention() const {
   return static_in_boxes > 0 ? static_cast<double>(static_in_boxes_kept) / static_in_boxes : 1.0;
 }
@@ -435,6 +442,8 @@ double ScreeningMetrics::staticRetention() const {
 ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
   dynamic_total += o.dynamic_total;
   dynamic_dropped += o.dynamic_dropped;
+  dynamic_outside_boxes += o.dynamic_outside_boxes;
+  dynamic_outside_dropped += o.dynamic_outside_dropped;
   static_in_boxes += o.static_in_boxes;
   static_in_boxes_kept += o.static_in_boxes_kept;
   static_total += o.static_total;
@@ -446,7 +455,11 @@ std::string ScreeningMetrics::toJson() const {
   std::ostringstream os;
   os.precision(6);
   os << "{\"dynamic_total\":" << dynamic_total << ",\"dynamic_dropped\":" << dynamic_dropped
-     << ",\"dynamic_recall\":" << dynamicRecall() << ",\"static_in_boxes\":" << static_in_boxes
+     << ",\"dynamic_recall\":" << dynamicRecall()
+     << ",\"dynamic_outside_boxes\":" << dynamic_outside_boxes
+     << ",\"dynamic_outside_dropped\":" << dynamic_outside_dropped
+     << ",\"dynamic_recall_in_boxes\":" << dynamicRecallInBoxes()
+     << ",\"static_in_boxes\":" << static_in_boxes
      << ",\"static_in_boxes_kept\":" << static_in_boxes_kept
      << ",\"static_retention\":" << staticRetention() << ",\"static_total\":" << static_total
      << ",\"static_dropped\":" << static_dropped << "}";
@@ -480,15 +493,19 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
     if (ignore_border_px > 0 && (dyn_gt ? !core_dyn.at<uint8_t>(y, x) : near_dyn.at<uint8_t>(y, x)))
       continue;
     const bool dropped = i < frame.dynamic.size() && frame.dynamic[i];
+    bool in_box = false;
+    for (const auto& b : boxes) in_box = in_box || inside(b.rect, p);
     if (dyn_gt) {
       ++m.dynamic_total;
       m.dynamic_dropped += dropped ? 1 : 0;
+      if (!in_box) {
+        ++m.dynamic_outside_boxes;
+        m.dynamic_outside_dropped += dropped ? 1 : 0;
+      }
       continue;
     }
     ++m.static_total;
     m.static_dropped += dropped ? 1 : 0;
-    bool in_box = false;
-    for (const auto& b : boxes) in_box = in_box || inside(b.rect, p);
     if (in_box) {
       ++m.static_in_boxes;
       m.static_in_boxes_kept += dropped ? 0 : 1;

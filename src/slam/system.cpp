@@ -42,12 +42,7 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     : cam_(cam), opt_(options.slam), voc_(std::move(vocabulary)) {
   const features::OrbOptions& orb_opt = options.orb;
   orb_ = std::make_unique<features::OrbExtractor>(orb_opt);
-  screener_ = std::make_unique<screening::Screener>(options.screening);
-  const screening::DynamicMode m = options.screening.mode;
-  if (options.screening.track_boxes &&
-      (m == screening::DynamicMode::Detect || m == screening::DynamicMode::DetectGeometry))
-    box_tracker_ = std::make_unique<screening::BoxTracker>(
-        screening::BoxTrackerOptions::from(options.screening));
+  screening_ = std::make_unique<screening::ScreeningPipeline>(options.screening);
   auto pyr = std::make_shared<ScalePyramid>(ScalePyramid::make(orb_opt.n_levels, orb_opt.scale_factor));
   map_ = std::make_unique<Map>();
   if (voc_) {
@@ -120,16 +115,13 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   }
   const double extraction_ms = sw.ms();
   sw.restart();
-  detection::Boxes used = boxes;
-  screening::ScreeningStats ss;
-  if (box_tracker_) {
-    std::lock_guard<std::mutex> lk(box_tracker_mutex_);
-    used = box_tracker_->predict(ff, boxes);
-    ss = screener_->screen(ff, used);
-    box_tracker_->observe(ff);
-  } else {
-    ss = screener_->screen(ff, used);
+  screening::PipelineResult screened;
+  {
+    std::lock_guard<std::mutex> lk(screening_mutex_);
+    screened = screening_->process(ff, boxes, cam_);
   }
+  const screening::ScreeningStats& ss = screened.stats;
+  detection::Boxes& used = screened.boxes;
   const double screening_ms = sw.ms();
   long n_tracked = 0;
   for (const auto& b : used) n_tracked += b.tracked ? 1 : 0;
@@ -140,6 +132,12 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     stats_.keypoints_in_boxes += ss.in_boxes;
     stats_.keypoints_kept += ss.kept;
     stats_.keypoints_dropped += ss.dropped;
+    stats_.keypoints_propagated += screened.temporal.propagated;
+    stats_.keypoints_vetoed += screened.temporal.vetoed;
+    stats_.boxes_vetoed += screened.temporal.boxes_vetoed;
+    stats_.temporal_matched += screened.temporal.matched;
+    stats_.temporal_static_consistent += screened.temporal.static_consistent;
+    stats_.temporal_motion_frames += screened.temporal.motion_ok ? 1 : 0;
     stats_.boxes_tracked += n_tracked;
     stats_.boxes_detected += static_cast<long>(used.size()) - n_tracked;
   }
@@ -259,7 +257,7 @@ void System::recordDetectionTime(double ms) {
 }
 
 const features::OrbExtractor& System::extractor() const { return *orb_; }
-const screening::Screener& System::screener() const { return *screener_; }
+const screening::Screener& System::screener() const { return screening_->screener(); }
 
 Trajectory System::cameraTrajectory() const {
   std::lock_guard<std::mutex> tl(track_mutex_);
@@ -335,7 +333,8 @@ std::string System::statsJson() const {
     << ",\n  \"relocalizations\": " << s.relocalizations << ",\n  \"loops_closed\": " << s.loops_closed
     << ",\n  \"global_bundle_adjustments\": " << s.global_bas
     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-    << ", \"dropped\": " << s.keypoints_dropped << "}"
+    << ", \"dropped\": " << s.keypoints_dropped << ", \"propagated\": " << s.keypoints_propagated
+    << ", \"vetoed\": " << s.keypoints_vetoed << "}"
     << ",\n  \"boxes\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
     << ",\n  \"timings\": {\n    \"extraction\": " << summaryJsonMs(summarize(s.extraction_ms))
     << ",\n    \"screening\": " << summaryJsonMs(summarize(s.screening_ms))

@@ -96,6 +96,20 @@ struct ScreeningOptions {
   int track_max_hamming = 50;
   int track_min_matches = 5;
   double track_min_score = 0.5;  // Screening.trackMinScore: last detection's score to carry
+  // Frame-to-frame evidence (screening::TemporalScreening in temporal.h, beyond the paper):
+  // label propagation (Screening.propagateLabels, propagateMaxAge) and the static-box veto
+  // (Screening.staticBoxVeto, staticBoxFraction, staticBoxMinPoints); matching and the static
+  // test: temporalRadius (px),
+  // temporalMaxHamming (bits), temporalMaxDepthChange (m), temporalStaticTolerance (px).
+  bool propagate_labels = false;
+  int propagate_max_age = 3;
+  bool static_box_veto = false;
+  double static_box_fraction = 0.9;
+  int static_box_min_points = 10;
+  double temporal_radius_px = 30;
+  int temporal_max_hamming = 50;
+  double temporal_max_depth_change_m = 0.2;
+  double temporal_static_tolerance_px = 3;
 
   // Reads Screening.mode, Screening.variant, Screening.varianceThreshold (m^2),
   // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
@@ -103,7 +117,11 @@ struct ScreeningOptions {
   // Screening.growDepth (m), Screening.clusterMinFraction, Screening.noDepthRadius (px),
   // Screening.dilationDepthOnly (bool), Screening.rejectFlatBoxes (bool), flatBoxFraction,
   // flatBoxTolerance (1/m), flatBoxRing, Screening.trackBoxes (bool), trackMaxAge,
-  // trackRadius, trackMaxHamming, trackMinMatches, trackMinScore. Invalid values throw
+  // trackRadius, trackMaxHamming, trackMinMatches, trackMinScore, Screening.propagateLabels
+  // (bool), propagateMaxAge, staticBoxVeto (bool), staticBoxFraction, staticBoxMinPoints,
+  // temporalRadius, temporalMaxHamming,
+  // temporalMaxDepthChange, temporalStaticTolerance.
+  // Invalid values throw
   // yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // Throws yolo_slam::Error (prefixed by `where`) if a value is out of range.
@@ -118,6 +136,11 @@ struct ScreeningStats {
   double ms = 0;       // wall time of screen()
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
 };
+
+// The box grown by fraction f of its width/height on each side (Screening.boxDilation).
+cv::Rect2f dilate(const cv::Rect2f& r, double f);
+// Whether p lies in r (right and bottom edges exclusive).
+bool inside(const cv::Rect2f& r, const cv::Point2f& p);
 
 // Eq. 8: k = log(1 - P) / log(1 - w^N). Returns +infinity when w <= 0 (no information yet) and
 // 0 when w >= 1.
@@ -163,6 +186,9 @@ class Screener {
 struct ScreeningMetrics {
   int dynamic_total = 0;          // keypoints on the ground-truth mask
   int dynamic_dropped = 0;        // of those, marked dynamic
+  int dynamic_outside_boxes = 0;  // of dynamic_total, inside no box: only label propagation
+                                  // (tracking, map points) can drop them
+  int dynamic_outside_dropped = 0;  // of those, marked dynamic
   int static_in_boxes = 0;        // keypoints off the mask inside at least one box
   int static_in_boxes_kept = 0;   // of those, left static
   int static_total = 0;           // keypoints off the mask anywhere
@@ -170,6 +196,8 @@ struct ScreeningMetrics {
 
   // dynamic_dropped / dynamic_total (1 when there is no dynamic keypoint).
   double dynamicRecall() const;
+  // Recall over the dynamic keypoints inside at least one box (what screening decides).
+  double dynamicRecallInBoxes() const;
   // static_in_boxes_kept / static_in_boxes (1 when there is no static keypoint in a box).
   double staticRetention() const;
   ScreeningMetrics& operator+=(const ScreeningMetrics& o);

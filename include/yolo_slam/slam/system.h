@@ -6,7 +6,7 @@
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
-#include "yolo_slam/screening/box_tracker.h"
+#include "yolo_slam/screening/pipeline.h"
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
@@ -48,6 +48,12 @@ struct SystemStats {
   size_t keyframes_culled = 0;
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
+  long keypoints_propagated = 0;  // marked dynamic by label propagation (propagateLabels)
+  long keypoints_vetoed = 0;      // screened dynamic, kept by the static-box veto (staticBoxVeto)
+  long boxes_vetoed = 0;          // boxes the static-box veto left alone
+  // Frame-to-frame evidence (propagateLabels or staticBoxVeto): keypoints matched to the
+  // previous frame, of those static-consistent, frames whose camera motion was estimated.
+  long temporal_matched = 0, temporal_static_consistent = 0, temporal_motion_frames = 0;
   // Boxes screened: from the detector, and carried by the BoxTracker (Screening.trackBoxes).
   long boxes_detected = 0, boxes_tracked = 0;
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
@@ -120,11 +126,10 @@ class System {
   CameraModel cam_;
   SlamOptions opt_;
   std::unique_ptr<features::OrbExtractor> orb_;
-  std::unique_ptr<screening::Screener> screener_;
-  // Null unless Screening.trackBoxes in mode detect or detect+geometry.
-  std::unique_ptr<screening::BoxTracker> box_tracker_;
-  // Guards box_tracker_ across predict/screen/observe of one frame (taken alone).
-  std::mutex box_tracker_mutex_;
+  // Box tracking, Algorithm 1 and label propagation; stateful between frames.
+  std::unique_ptr<screening::ScreeningPipeline> screening_;
+  // Guards screening_ for the whole of one frame's process() (taken alone).
+  std::mutex screening_mutex_;
   std::shared_ptr<const vocabulary::Vocabulary> voc_;
   // Declared before map_: the map removes keyframes from it until destroyed.
   std::unique_ptr<vocabulary::KeyFrameDatabase> kfdb_;

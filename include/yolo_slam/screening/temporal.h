@@ -1,0 +1,104 @@
+#pragma once
+// Frame-to-frame evidence for screening (beyond the paper). Each keypoint is matched to the
+// previous frame (ORB descriptor near its old position); the camera motion between the frames is
+// estimated from the matched static keypoints with depth (3D-2D PnP RANSAC); a match that lands
+// within static_tolerance_px of where its point would be if it were static is "static-consistent".
+// Two uses, each with its own switch:
+//
+// - Label propagation (Screening.propagateLabels): a keypoint matched to a dynamic keypoint of
+//   the previous frame that MOVED (not static-consistent) is dynamic too, box or no box. Most
+//   dynamic keypoints screening misses lie outside every box (the detector loses people for a
+//   few frames or clips an arm). Static background wrongly dropped inside boxes (static
+//   retention is 55-70 %) is static-consistent and does not propagate. A label travels at most
+//   propagate_max_age frames without screening confirming it.
+// - Static-box veto (Screening.staticBoxVeto, off by default): a box whose dropped keypoints are
+//   nearly all (staticBoxFraction of those that can be tested, at least staticBoxMinPoints)
+//   where static points would be is left alone (its keypoints kept): a false detection (a
+//   picture, a poster) never moves. But a seated person moves a fraction of a pixel per frame
+//   and passes too; keeping them ruins the map when they shift (docs/ablation.md: static_xyz
+//   3.9 -> 3.0 mm, sitting_static 4.9 -> 53 mm), hence off.
+//
+// Per frame, after Screener::screen:  temporal.apply(frame, boxes, cam);
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/detection/box.h"
+#include "yolo_slam/features/feature_frame.h"
+
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+namespace yolo_slam {
+namespace screening {
+
+struct ScreeningOptions;
+
+struct TemporalOptions {
+  bool propagate_labels = false;
+  // Frames a label travels without being confirmed by screening (1: one frame ahead only).
+  int propagate_max_age = 3;
+  bool static_box_veto = false;
+  double static_box_fraction = 0.9;  // share of a box's tested dropped keypoints
+  int static_box_min_points = 10;    // fewer tested keypoints: no verdict, the box stays
+  double box_dilation = 0.05;        // Screening.boxDilation: the region the screener used
+  // Pixel radius of the search around a keypoint's position in the previous frame (a walking
+  // person moves tens of pixels per frame at 30 Hz).
+  double radius_px = 30;
+  // A match needs at most this Hamming distance (of 256 bits); 50 is ORB-SLAM2's TH_LOW.
+  int max_hamming = 50;
+  // When both keypoints have depth, they must differ by at most this (metres) to be one point.
+  double max_depth_change_m = 0.2;
+  // A match closer than this (pixels at pyramid level 0, times the level's scale) to the
+  // position predicted for a static point is static.
+  double static_tolerance_px = 3;
+
+  bool enabled() const { return propagate_labels || static_box_veto; }
+  // The fields of ScreeningOptions (Screening.propagateLabels, propagateMaxAge, staticBoxVeto,
+  // staticBoxFraction, staticBoxMinPoints, temporalRadius, temporalMaxHamming,
+  // temporalMaxDepthChange, temporalStaticTolerance, boxDilation).
+  static TemporalOptions from(const ScreeningOptions& s);
+  // Throws yolo_slam::Error (prefixed by `where`) for out-of-range values.
+  void validate(const std::string& where = "TemporalOptions") const;
+};
+
+// What the last apply() did (for tests, benchmarks and the docs).
+struct TemporalStats {
+  bool motion_ok = false;       // the camera motion was estimated (else nothing changes)
+  int motion_inliers = 0;
+  int matched = 0;              // keypoints matched to the previous frame
+  int static_consistent = 0;    // of those, where a static point would be
+  int propagated = 0;           // keypoints marked dynamic by label propagation
+  int boxes_vetoed = 0;         // boxes left alone by the static-box veto
+  int vetoed = 0;               // screened-dynamic keypoints they kept
+};
+
+// One per camera stream; deterministic. Not thread-safe: the caller serialises frames.
+class TemporalScreening {
+ public:
+  explicit TemporalScreening(const TemporalOptions& options);  // validates
+  const TemporalOptions& options() const { return opt_; }
+
+  // After Screener::screen on `frame` with `boxes`: the static-box veto, then label
+  // propagation, then `frame` becomes the previous frame of the next call.
+  TemporalStats apply(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                      const CameraModel& cam);
+  void clear();
+
+ private:
+  // Camera motion from the previous frame to the current one (X_cur = R X_prev + t) from the
+  // matched pairs whose both ends are static; false when too few agree.
+  bool estimateMotion(const features::FeatureFrame& frame, const std::vector<int>& match,
+                      const CameraModel& cam, cv::Matx33d& R, cv::Vec3d& t, int& inliers) const;
+
+  // Static pairs -> camera motion (EPnP RANSAC, then Levenberg-Marquardt on the inliers).
+  static bool solveMotion(const std::vector<cv::Point3f>& obj, const std::vector<cv::Point2f>& img,
+                          const CameraModel& cam, cv::Matx33d& R, cv::Vec3d& t, int* n_inliers);
+
+  TemporalOptions opt_;
+  features::FeatureFrame prev_;     // keypoints, descriptors, depth, dynamic of the last frame
+  std::vector<cv::Point3f> prev_X_;  // its keypoints in its camera frame (z <= 0: no depth)
+  std::vector<int> prev_age_;        // label age per keypoint (0: screened or static)
+};
+
+}  // namespace screening
+}  // namespace yolo_slam

@@ -1,0 +1,243 @@
+// Frame-to-frame evidence (screening/temporal.h) on constructed RGB-D frames: a textured wall
+// 3 m away, a person 1.5 m away, a camera that moves between frames; keypoints are the exact
+// projections of the 3D points, descriptors fixed per point.
+#include "yolo_slam/screening/temporal.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/screening/screener.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <random>
+
+using namespace yolo_slam;
+using screening::TemporalOptions;
+using screening::TemporalScreening;
+using screening::TemporalStats;
+
+namespace {
+
+struct Point {
+  cv::Vec3d X;  // world coordinates (camera 0 = world)
+  cv::Mat desc;
+  bool person = false;
+};
+
+struct World {
+  std::vector<Point> points;
+};
+
+// Wall points spread over the view at 3 m; person points in a 0.5 x 1.2 m patch at 1.5 m
+// centred at (person_x, 0).
+World makeWorld(int n_wall, int n_person, double person_x, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  cv::RNG cvrng(seed);
+  World w;
+  auto add = [&](const cv::Vec3d& X, bool person) {
+    Point p;
+    p.X = X;
+    p.person = person;
+    p.desc.create(1, 32, CV_8U);
+    cvrng.fill(p.desc, cv::RNG::UNIFORM, 0, 256);
+    w.points.push_back(p);
+  };
+  for (int i = 0; i < n_wall; ++i) add({1.6 * u(rng), 1.2 * u(rng), 3.0}, false);
+  for (int i = 0; i < n_person; ++i) add({person_x + 0.25 * u(rng), 0.6 * u(rng), 1.5}, true);
+  return w;
+}
+
+CameraModel camera() { return CameraModel(); }  // TUM fr3 intrinsics, 640 x 480
+
+// The frame seen by a camera at (cam_x, 0, 0) looking down +z, with the person shifted by
+// person_dx metres; `person_dynamic` flags the person's keypoints dynamic (screened), and
+// `wall_dynamic_box` flags wall keypoints inside that image box (a false detection's drop).
+features::FeatureFrame render(const World& w, double cam_x, double person_dx, bool person_dynamic,
+                              const cv::Rect2f& wall_dynamic_box = cv::Rect2f()) {
+  const CameraModel cam = camera();
+  features::FeatureFrame f;
+  f.width = cam.width;
+  f.height = cam.height;
+  std::vector<cv::Mat> rows;
+  for (const auto& p : w.points) {
+    const cv::Vec3d Xc = p.X + cv::Vec3d(p.person ? person_dx : 0.0, 0, 0) - cv::Vec3d(cam_x, 0, 0);
+    const float u = static_cast<float>(cam.fx * Xc[0] / Xc[2] + cam.cx);
+    const float v = static_cast<float>(cam.fy * Xc[1] / Xc[2] + cam.cy);
+    if (!cam.inImage(u, v)) continue;
+    f.keypoints.emplace_back(cv::Point2f(u, v), 31.f);  // level 0: size = patch diameter
+    f.depth.push_back(static_cast<float>(Xc[2]));
+    const bool dyn = p.person ? person_dynamic : wall_dynamic_box.contains(cv::Point2f(u, v));
+    f.dynamic.push_back(dyn ? 1 : 0);
+    rows.push_back(p.desc);
+  }
+  cv::vconcat(rows, f.descriptors);
+  f.keypoints_un = f.keypoints;
+  f.right_u.assign(f.keypoints.size(), -1.f);
+  return f;
+}
+
+int countDynamic(const features::FeatureFrame& f, const World& w, bool person) {
+  // Keypoints are in world-point order when every point is in the image (true of every scene
+  // and camera position here).
+  EXPECT_EQ(f.size(), w.points.size());
+  int n = 0;
+  for (size_t i = 0; i < f.size(); ++i) n += (f.dynamic[i] && w.points[i].person == person) ? 1 : 0;
+  return n;
+}
+
+TemporalOptions propagation() {
+  TemporalOptions o;
+  o.propagate_labels = true;
+  return o;
+}
+
+detection::Box box(const cv::Rect2f& r) {
+  detection::Box b;
+  b.label = "person";
+  b.score = 0.9f;
+  b.rect = r;
+  return b;
+}
+
+}  // namespace
+
+TEST(Temporal, StaticSceneIsStaticConsistentUnderCameraMotion) {
+  const World w = makeWorld(200, 0, 0, 1);
+  TemporalScreening ts(propagation());
+  features::FeatureFrame f0 = render(w, 0.0, 0, false);
+  ASSERT_EQ(f0.size(), w.points.size());
+  ts.apply(f0, {}, camera());
+  features::FeatureFrame f1 = render(w, 0.03, 0, false);  // 3 cm sideways: ~5 px of parallax
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  EXPECT_TRUE(st.motion_ok);
+  EXPECT_EQ(st.matched, 200);
+  EXPECT_EQ(st.static_consistent, 200);
+  EXPECT_EQ(st.propagated, 0);
+}
+
+TEST(Temporal, LabelsOfAMovingPersonPropagateWhereTheDetectorMissedThem) {
+  const World w = makeWorld(200, 60, 0.3, 2);
+  TemporalScreening ts(propagation());
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
+  ASSERT_EQ(f0.size(), w.points.size());
+  ts.apply(f0, {}, camera());
+  // Frame 1: no detection (person not screened); the person walked 5 cm (~18 px at 1.5 m).
+  features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
+  ASSERT_EQ(f1.size(), w.points.size());
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  ASSERT_TRUE(st.motion_ok);
+  EXPECT_EQ(st.propagated, 60);
+  EXPECT_EQ(countDynamic(f1, w, true), 60);
+  EXPECT_EQ(countDynamic(f1, w, false), 0);
+}
+
+TEST(Temporal, WronglyDroppedBackgroundDoesNotPropagate) {
+  const World w = makeWorld(300, 0, 0, 3);
+  TemporalScreening ts(propagation());
+  // A false detection dropped the wall keypoints in this box in frame 0 only.
+  features::FeatureFrame f0 = render(w, 0.0, 0, false, cv::Rect2f(100, 100, 200, 200));
+  const int dropped0 = static_cast<int>(f0.countDynamic());
+  ASSERT_GT(dropped0, 20);
+  ts.apply(f0, {}, camera());
+  features::FeatureFrame f1 = render(w, 0.02, 0, false);
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  ASSERT_TRUE(st.motion_ok);
+  EXPECT_EQ(st.propagated, 0);
+  EXPECT_EQ(f1.countDynamic(), 0u);
+}
+
+TEST(Temporal, LabelsStopAfterMaxAgeFramesWithoutScreening) {
+  const World w = makeWorld(200, 60, 0.2, 4);
+  TemporalOptions o = propagation();
+  o.propagate_max_age = 2;
+  TemporalScreening ts(o);
+  features::FeatureFrame f = render(w, 0.0, 0.0, true);
+  ts.apply(f, {}, camera());
+  std::vector<int> marked;
+  for (int k = 1; k <= 4; ++k) {
+    f = render(w, 0.01 * k, 0.04 * k, false);  // person keeps walking, never detected again
+    marked.push_back(ts.apply(f, {}, camera()).propagated);
+  }
+  EXPECT_EQ(marked[0], 60);
+  EXPECT_EQ(marked[1], 60);
+  EXPECT_EQ(marked[2], 0);
+  EXPECT_EQ(marked[3], 0);
+}
+
+TEST(Temporal, StaticBoxVetoKeepsAFalseDetectionButNotAWalkingPerson) {
+  const World w = makeWorld(300, 60, 0.3, 5);
+  TemporalOptions o;
+  o.static_box_veto = true;
+  o.box_dilation = 0;
+  TemporalScreening ts(o);
+  const cv::Rect2f picture(60, 60, 150, 150);  // a false detection on the wall, top left
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, true, picture);
+  ts.apply(f0, {}, camera());
+  features::FeatureFrame f1 = render(w, 0.02, 0.05, true, picture);
+  const int wall_dropped = countDynamic(f1, w, false);
+  ASSERT_GE(wall_dropped, 10);
+  // The person's box: around the person's keypoints in frame 1.
+  std::vector<cv::Point2f> pts;
+  for (size_t i = 0; i < f1.size(); ++i)
+    if (w.points[i].person) pts.push_back(f1.keypoints[i].pt);
+  const cv::Rect person_rect = cv::boundingRect(pts);
+  const cv::Rect2f person(person_rect.x - 2.f, person_rect.y - 2.f, person_rect.width + 4.f,
+                          person_rect.height + 4.f);
+  ASSERT_TRUE((person & picture).empty());
+  const TemporalStats st = ts.apply(f1, {box(picture), box(person)}, camera());
+  ASSERT_TRUE(st.motion_ok);
+  EXPECT_EQ(st.boxes_vetoed, 1);
+  EXPECT_EQ(st.vetoed, wall_dropped);
+  EXPECT_EQ(countDynamic(f1, w, false), 0);   // the picture's keypoints are kept
+  EXPECT_EQ(countDynamic(f1, w, true), 60);   // the walking person stays dropped
+}
+
+TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
+  // Too few static keypoints with depth: the motion is unknown, so no label can be judged.
+  const World w = makeWorld(8, 60, 0.0, 6);
+  TemporalScreening ts(propagation());
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
+  ts.apply(f0, {}, camera());
+  features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  EXPECT_FALSE(st.motion_ok);
+  EXPECT_EQ(st.propagated, 0);
+  EXPECT_EQ(f1.countDynamic(), 0u);
+}
+
+TEST(Temporal, ClearForgetsThePreviousFrame) {
+  const World w = makeWorld(200, 60, 0.3, 7);
+  TemporalScreening ts(propagation());
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
+  ts.apply(f0, {}, camera());
+  ts.clear();
+  features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  EXPECT_EQ(st.matched, 0);
+  EXPECT_EQ(f1.countDynamic(), 0u);
+}
+
+TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
+  const Config cfg = Config::fromString(
+      "%YAML:1.0\nScreening.propagateLabels: 1\nScreening.propagateMaxAge: 5\n"
+      "Screening.staticBoxVeto: 1\nScreening.staticBoxFraction: 0.8\n"
+      "Screening.temporalStaticTolerance: 4\n");
+  const TemporalOptions o = TemporalOptions::from(screening::ScreeningOptions::load(cfg));
+  EXPECT_TRUE(o.propagate_labels);
+  EXPECT_EQ(o.propagate_max_age, 5);
+  EXPECT_TRUE(o.static_box_veto);
+  EXPECT_DOUBLE_EQ(o.static_box_fraction, 0.8);
+  EXPECT_DOUBLE_EQ(o.static_tolerance_px, 4.0);
+  try {
+    screening::ScreeningOptions::load(
+        Config::fromString("%YAML:1.0\nScreening.staticBoxFraction: 1.5\n"));
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("staticBoxFraction"), std::string::npos) << e.what();
+  }
+  TemporalOptions bad;
+  bad.propagate_max_age = 0;
+  EXPECT_THROW(TemporalScreening{bad}, Error);
+}
