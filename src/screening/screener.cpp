@@ -140,6 +140,7 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   o.static_box_veto = cfg.getBool("Screening.staticBoxVeto", o.static_box_veto);
   o.static_box_fraction = cfg.getDouble("Screening.staticBoxFraction", o.static_box_fraction);
   o.static_box_min_points = cfg.getInt("Screening.staticBoxMinPoints", o.static_box_min_points);
+  o.static_box_max_score = cfg.getDouble("Screening.staticBoxMaxScore", o.static_box_max_score);
   o.temporal_radius_px = cfg.getDouble("Screening.temporalRadius", o.temporal_radius_px);
   o.temporal_max_hamming = cfg.getInt("Screening.temporalMaxHamming", o.temporal_max_hamming);
   o.temporal_max_depth_change_m =

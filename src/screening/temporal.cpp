@@ -40,6 +40,7 @@ TemporalOptions TemporalOptions::from(const ScreeningOptions& s) {
   o.static_box_veto = s.static_box_veto;
   o.static_box_fraction = s.static_box_fraction;
   o.static_box_min_points = s.static_box_min_points;
+  o.static_box_max_score = s.static_box_max_score;
   o.box_dilation = s.box_dilation;
   o.radius_px = s.temporal_radius_px;
   o.max_hamming = s.temporal_max_hamming;
@@ -54,6 +55,8 @@ void TemporalOptions::validate(const std::string& where) const {
     bad("propagateMaxAge must be >= 1 (frames), got " + std::to_string(propagate_max_age));
   if (!(static_box_fraction > 0 && static_box_fraction <= 1))
     bad("staticBoxFraction must be in (0, 1], got " + std::to_string(static_box_fraction));
+  if (!(static_box_max_score >= 0 && static_box_max_score <= 1))
+    bad("staticBoxMaxScore must be in [0, 1], got " + std::to_string(static_box_max_score));
   if (static_box_min_points < 1)
     bad("staticBoxMinPoints must be >= 1, got " + std::to_string(static_box_min_points));
   if (!(radius_px > 0) || !std::isfinite(radius_px))
@@ -169,6 +172,7 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
     for (const auto& b : boxes) regions.push_back(dilate(b.rect, opt_.box_dilation));
     std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
     for (size_t b = 0; b < regions.size(); ++b) {
+      if (boxes[b].score >= opt_.static_box_max_score) continue;
       int tested = 0, consistent = 0;
       for (size_t i = 0; i < n; ++i) {
         if (!frame.dynamic[i] || verdict[i] < 0 || !inside(regions[b], frame.keypoints[i].pt)) continue;

@@ -90,13 +90,14 @@ int countDynamic(const features::FeatureFrame& f, const World& w, bool person) {
 TemporalOptions propagation() {
   TemporalOptions o;
   o.propagate_labels = true;
+  o.static_box_veto = false;
   return o;
 }
 
-detection::Box box(const cv::Rect2f& r) {
+detection::Box box(const cv::Rect2f& r, float score) {
   detection::Box b;
   b.label = "person";
-  b.score = 0.9f;
+  b.score = score;
   b.rect = r;
   return b;
 }
@@ -166,32 +167,62 @@ TEST(Temporal, LabelsStopAfterMaxAgeFramesWithoutScreening) {
   EXPECT_EQ(marked[3], 0);
 }
 
-TEST(Temporal, StaticBoxVetoKeepsAFalseDetectionButNotAWalkingPerson) {
-  const World w = makeWorld(300, 60, 0.3, 5);
+// Two frames: a walking person (dropped), and a false detection on the wall top left whose
+// wall keypoints were dropped too.
+struct VetoScene {
+  World w = makeWorld(300, 60, 0.3, 5);
+  cv::Rect2f picture{60, 60, 150, 150};
+  features::FeatureFrame f1;
+  cv::Rect2f person;
+};
+
+VetoScene vetoScene(TemporalScreening& ts) {
+  VetoScene v;
+  features::FeatureFrame f0 = render(v.w, 0.0, 0.0, true, v.picture);
+  ts.apply(f0, {}, camera());
+  v.f1 = render(v.w, 0.02, 0.05, true, v.picture);
+  std::vector<cv::Point2f> pts;
+  for (size_t i = 0; i < v.f1.size(); ++i)
+    if (v.w.points[i].person) pts.push_back(v.f1.keypoints[i].pt);
+  const cv::Rect r = cv::boundingRect(pts);
+  v.person = cv::Rect2f(r.x - 2.f, r.y - 2.f, r.width + 4.f, r.height + 4.f);
+  return v;
+}
+
+TemporalOptions vetoOnly() {
   TemporalOptions o;
   o.static_box_veto = true;
   o.box_dilation = 0;
-  TemporalScreening ts(o);
-  const cv::Rect2f picture(60, 60, 150, 150);  // a false detection on the wall, top left
-  features::FeatureFrame f0 = render(w, 0.0, 0.0, true, picture);
-  ts.apply(f0, {}, camera());
-  features::FeatureFrame f1 = render(w, 0.02, 0.05, true, picture);
+  return o;
+}
+
+TEST(Temporal, StaticBoxVetoKeepsAnUnsureFalseDetectionButNotAWalkingPerson) {
+  TemporalScreening ts(vetoOnly());
+  VetoScene v = vetoScene(ts);
+  features::FeatureFrame& f1 = v.f1;
+  const World& w = v.w;
+  const cv::Rect2f picture = v.picture, person = v.person;
   const int wall_dropped = countDynamic(f1, w, false);
   ASSERT_GE(wall_dropped, 10);
-  // The person's box: around the person's keypoints in frame 1.
-  std::vector<cv::Point2f> pts;
-  for (size_t i = 0; i < f1.size(); ++i)
-    if (w.points[i].person) pts.push_back(f1.keypoints[i].pt);
-  const cv::Rect person_rect = cv::boundingRect(pts);
-  const cv::Rect2f person(person_rect.x - 2.f, person_rect.y - 2.f, person_rect.width + 4.f,
-                          person_rect.height + 4.f);
   ASSERT_TRUE((person & picture).empty());
-  const TemporalStats st = ts.apply(f1, {box(picture), box(person)}, camera());
+  // Scores below staticBoxMaxScore (0.8): both boxes may be vetoed, only the picture is.
+  const TemporalStats st = ts.apply(f1, {box(picture, 0.5f), box(person, 0.6f)}, camera());
   ASSERT_TRUE(st.motion_ok);
   EXPECT_EQ(st.boxes_vetoed, 1);
   EXPECT_EQ(st.vetoed, wall_dropped);
   EXPECT_EQ(countDynamic(f1, w, false), 0);   // the picture's keypoints are kept
   EXPECT_EQ(countDynamic(f1, w, true), 60);   // the walking person stays dropped
+}
+
+TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
+  // A seated person is as still as a picture; the detector is sure of people, not of pictures.
+  TemporalScreening ts(vetoOnly());
+  VetoScene v = vetoScene(ts);
+  const int wall_dropped = countDynamic(v.f1, v.w, false);
+  const TemporalStats st = ts.apply(v.f1, {box(v.picture, 0.95f), box(v.person, 0.95f)}, camera());
+  ASSERT_TRUE(st.motion_ok);
+  EXPECT_EQ(st.boxes_vetoed, 0);
+  EXPECT_EQ(countDynamic(v.f1, v.w, false), wall_dropped);
 }
 
 TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
@@ -222,12 +253,12 @@ TEST(Temporal, ClearForgetsThePreviousFrame) {
 TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
   const Config cfg = Config::fromString(
       "%YAML:1.0\nScreening.propagateLabels: 1\nScreening.propagateMaxAge: 5\n"
-      "Screening.staticBoxVeto: 1\nScreening.staticBoxFraction: 0.8\n"
+      "Screening.staticBoxVeto: 0\nScreening.staticBoxFraction: 0.8\n"
       "Screening.temporalStaticTolerance: 4\n");
   const TemporalOptions o = TemporalOptions::from(screening::ScreeningOptions::load(cfg));
   EXPECT_TRUE(o.propagate_labels);
   EXPECT_EQ(o.propagate_max_age, 5);
-  EXPECT_TRUE(o.static_box_veto);
+  EXPECT_FALSE(o.static_box_veto);
   EXPECT_DOUBLE_EQ(o.static_box_fraction, 0.8);
   EXPECT_DOUBLE_EQ(o.static_tolerance_px, 4.0);
   try {

@@ -98,14 +98,16 @@ struct ScreeningOptions {
   double track_min_score = 0.5;  // Screening.trackMinScore: last detection's score to carry
   // Frame-to-frame evidence (screening::TemporalScreening in temporal.h, beyond the paper):
   // label propagation (Screening.propagateLabels, propagateMaxAge) and the static-box veto
-  // (Screening.staticBoxVeto, staticBoxFraction, staticBoxMinPoints); matching and the static
+  // (Screening.staticBoxVeto, staticBoxFraction, staticBoxMinPoints, staticBoxMaxScore);
+  // matching and the static
   // test: temporalRadius (px),
   // temporalMaxHamming (bits), temporalMaxDepthChange (m), temporalStaticTolerance (px).
   bool propagate_labels = false;
   int propagate_max_age = 3;
-  bool static_box_veto = false;
+  bool static_box_veto = true;
   double static_box_fraction = 0.9;
   int static_box_min_points = 10;
+  double static_box_max_score = 0.8;
   double temporal_radius_px = 30;
   int temporal_max_hamming = 50;
   double temporal_max_depth_change_m = 0.2;
@@ -119,6 +121,7 @@ struct ScreeningOptions {
   // flatBoxTolerance (1/m), flatBoxRing, Screening.trackBoxes (bool), trackMaxAge,
   // trackRadius, trackMaxHamming, trackMinMatches, trackMinScore, Screening.propagateLabels
   // (bool), propagateMaxAge, staticBoxVeto (bool), staticBoxFraction, staticBoxMinPoints,
+  // staticBoxMaxScore,
   // temporalRadius, temporalMaxHamming,
   // temporalMaxDepthChange, temporalStaticTolerance.
   // Invalid values throw

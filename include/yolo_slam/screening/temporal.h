@@ -11,12 +11,13 @@
 //   few frames or clips an arm). Static background wrongly dropped inside boxes (static
 //   retention is 55-70 %) is static-consistent and does not propagate. A label travels at most
 //   propagate_max_age frames without screening confirming it.
-// - Static-box veto (Screening.staticBoxVeto, off by default): a box whose dropped keypoints are
-//   nearly all (staticBoxFraction of those that can be tested, at least staticBoxMinPoints)
-//   where static points would be is left alone (its keypoints kept): a false detection (a
-//   picture, a poster) never moves. But a seated person moves a fraction of a pixel per frame
-//   and passes too; keeping them ruins the map when they shift (docs/ablation.md: static_xyz
-//   3.9 -> 3.0 mm, sitting_static 4.9 -> 53 mm), hence off.
+// - Static-box veto (Screening.staticBoxVeto, on by default): a box scored below staticBoxMaxScore whose
+//   dropped keypoints are nearly all (staticBoxFraction of those that can be tested, at least
+//   staticBoxMinPoints) where static points would be is left alone (its keypoints kept): a false
+//   detection (a picture, a poster) never moves. A seated person moves a fraction of a pixel per
+//   frame and passes the motion test too, and keeping them ruins the map when they shift
+//   (sitting_static 4.9 -> 53 mm without the score bound); but the detector is sure of them
+//   (scores 0.97-1.0 there) and unsure of its false positives (static_xyz: 95 % below 0.8).
 //
 // Per frame, after Screener::screen:  temporal.apply(frame, boxes, cam);
 #include "yolo_slam/common/camera.h"
@@ -37,9 +38,10 @@ struct TemporalOptions {
   bool propagate_labels = false;
   // Frames a label travels without being confirmed by screening (1: one frame ahead only).
   int propagate_max_age = 3;
-  bool static_box_veto = false;
+  bool static_box_veto = true;
   double static_box_fraction = 0.9;  // share of a box's tested dropped keypoints
   int static_box_min_points = 10;    // fewer tested keypoints: no verdict, the box stays
+  double static_box_max_score = 0.8;  // boxes scored at least this are never vetoed
   double box_dilation = 0.05;        // Screening.boxDilation: the region the screener used
   // Pixel radius of the search around a keypoint's position in the previous frame (a walking
   // person moves tens of pixels per frame at 30 Hz).
@@ -54,7 +56,7 @@ struct TemporalOptions {
 
   bool enabled() const { return propagate_labels || static_box_veto; }
   // The fields of ScreeningOptions (Screening.propagateLabels, propagateMaxAge, staticBoxVeto,
-  // staticBoxFraction, staticBoxMinPoints, temporalRadius, temporalMaxHamming,
+  // staticBoxFraction, staticBoxMinPoints, staticBoxMaxScore, temporalRadius, temporalMaxHamming,
   // temporalMaxDepthChange, temporalStaticTolerance, boxDilation).
   static TemporalOptions from(const ScreeningOptions& s);
   // Throws yolo_slam::Error (prefixed by `where`) for out-of-range values.
