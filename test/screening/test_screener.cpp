@@ -335,6 +335,30 @@ TEST(Metrics, IgnoredBorderBand) {
   EXPECT_EQ(core.static_in_boxes_kept, 1);
 }
 
+TEST(Metrics, DynamicKeypointsOutsideEveryBoxAreCountedApart) {
+  features::FeatureFrame f;
+  f.width = 100;
+  f.height = 100;
+  cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(40, 0, 40, 100)).setTo(255);  // a person from x = 40 to 79
+  // On the mask: 45 and 50 inside the box (one dropped), 70 and 75 outside it (one dropped).
+  for (float x : {45.f, 50.f, 70.f, 75.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
+  f.dynamic = {1, 0, 1, 0, 0};
+  detection::Boxes boxes(1);
+  boxes[0].rect = cv::Rect2f(40, 0, 20, 100);  // the box clips the person's right half
+  ScreeningMetrics m = evaluateScreening(f, mask, boxes);
+  EXPECT_EQ(m.dynamic_total, 4);
+  EXPECT_EQ(m.dynamic_dropped, 2);
+  EXPECT_EQ(m.dynamic_outside_boxes, 2);
+  EXPECT_EQ(m.dynamic_outside_dropped, 1);
+  EXPECT_DOUBLE_EQ(m.dynamicRecall(), 0.5);
+  EXPECT_DOUBLE_EQ(m.dynamicRecallInBoxes(), 0.5);
+  ScreeningMetrics sum = m;
+  sum += m;
+  EXPECT_EQ(sum.dynamic_outside_boxes, 4);
+  EXPECT_NE(m.toJson().find("\"dynamic_outside_boxes\":2"), std::string::npos) << m.toJson();
+}
+
 TEST(NearestVariant, PersonIsTheNearestClusterWhenTheBackgroundDominatesTheBox) {
   // A sitting person (60 keypoints, 1.8-2.0 m) in a box filled mostly by a desk/wall at 3.5 m
   // (150 keypoints): Algorithm 1's "largest set" is the background, the nearest sizeable
