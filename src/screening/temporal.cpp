@@ -129,10 +129,11 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
   std::vector<int> age(n, 0), match(n, -1);
   const bool usable = frame.descriptors.rows == static_cast<int>(n) && !prev_.keypoints.empty();
   if (usable) {
+    const features::KeypointIndex index(prev_, opt_.radius_px);
     for (size_t i = 0; i < n; ++i) {
-      const int j = features::bestMatchNear(prev_, frame.keypoints[i].pt,
-                                            frame.descriptors.ptr<uint8_t>(static_cast<int>(i)),
-                                            opt_.radius_px, opt_.max_hamming);
+      const int j = index.bestMatchNear(frame.keypoints[i].pt,
+                                        frame.descriptors.ptr<uint8_t>(static_cast<int>(i)),
+                                        opt_.radius_px, opt_.max_hamming);
       if (j < 0) continue;
       const float d = depthOf(frame, i), dp = prev_X_[j].z;
       if (d > 0 && dp > 0 && std::fabs(d - dp) > opt_.max_depth_change_m) continue;

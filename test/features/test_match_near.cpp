@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 using namespace yolo_slam;
 
 namespace {
@@ -41,4 +43,29 @@ TEST(MatchNear, NoMatchWithoutDescriptorsForEveryKeypoint) {
   features::FeatureFrame f;
   f.keypoints.emplace_back(cv::Point2f(10, 10), 31.f);  // descriptors missing
   EXPECT_EQ(features::bestMatchNear(f, {10, 10}, base.ptr<uint8_t>(), 10, 256), -1);
+}
+
+TEST(MatchNear, IndexAnswersExactlyLikeTheLinearSearch) {
+  // Keypoints on a coarse lattice with few distinct descriptors: many candidates, many ties.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> ux(-5.f, 645.f), uy(-5.f, 485.f);
+  cv::Mat palette(4, 32, CV_8U);
+  cv::RNG(6).fill(palette, cv::RNG::UNIFORM, 0, 256);
+  features::FeatureFrame f;
+  for (int i = 0; i < 800; ++i) {
+    f.keypoints.emplace_back(cv::Point2f(std::round(ux(rng) / 4) * 4, std::round(uy(rng) / 4) * 4), 31.f);
+    f.descriptors.push_back(palette.row(i % 4));
+  }
+  for (double cell : {7.0, 30.0, 200.0}) {
+    const features::KeypointIndex index(f, cell);
+    for (int q = 0; q < 300; ++q) {
+      const cv::Point2f p(ux(rng), uy(rng));
+      const uint8_t* d = palette.ptr<uint8_t>(q % 4);
+      for (double r : {3.0, 30.0, 90.0})
+        ASSERT_EQ(index.bestMatchNear(p, d, r, 50), features::bestMatchNear(f, p, d, r, 50))
+            << "cell " << cell << " radius " << r << " query (" << p.x << ", " << p.y << ")";
+    }
+  }
+  features::FeatureFrame empty;
+  EXPECT_EQ(features::KeypointIndex(empty, 30).bestMatchNear({1, 1}, palette.ptr<uint8_t>(0), 30, 256), -1);
 }
