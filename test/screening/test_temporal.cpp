@@ -253,13 +253,13 @@ TEST(Temporal, ClearForgetsThePreviousFrame) {
 TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
   const Config cfg = Config::fromString(
       "%YAML:1.0\nScreening.propagateLabels: 1\nScreening.propagateMaxAge: 5\n"
-      "Screening.staticBoxVeto: 0\nScreening.staticBoxFraction: 0.8\n"
+      "Screening.staticBoxVeto: 0\nScreening.staticBoxFraction: 0.7\n"
       "Screening.temporalStaticTolerance: 4\n");
   const TemporalOptions o = TemporalOptions::from(screening::ScreeningOptions::load(cfg));
   EXPECT_TRUE(o.propagate_labels);
   EXPECT_EQ(o.propagate_max_age, 5);
   EXPECT_FALSE(o.static_box_veto);
-  EXPECT_DOUBLE_EQ(o.static_box_fraction, 0.8);
+  EXPECT_DOUBLE_EQ(o.static_box_fraction, 0.7);
   EXPECT_DOUBLE_EQ(o.static_tolerance_px, 4.0);
   try {
     screening::ScreeningOptions::load(

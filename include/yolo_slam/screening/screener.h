@@ -105,7 +105,7 @@ struct ScreeningOptions {
   bool propagate_labels = false;
   int propagate_max_age = 3;
   bool static_box_veto = true;
-  double static_box_fraction = 0.9;
+  double static_box_fraction = 0.8;
   int static_box_min_points = 10;
   double static_box_max_score = 0.8;
   double temporal_radius_px = 30;

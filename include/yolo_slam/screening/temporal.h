@@ -39,7 +39,7 @@ struct TemporalOptions {
   // Frames a label travels without being confirmed by screening (1: one frame ahead only).
   int propagate_max_age = 3;
   bool static_box_veto = true;
-  double static_box_fraction = 0.9;  // share of a box's tested dropped keypoints
+  double static_box_fraction = 0.8;  // share of a box's tested dropped keypoints
   int static_box_min_points = 10;    // fewer tested keypoints: no verdict, the box stays
   double static_box_max_score = 0.8;  // boxes scored at least this are never vetoed
   double box_dilation = 0.05;        // Screening.boxDilation: the region the screener used
