@@ -3,7 +3,11 @@
 # (ORB-SLAM2 / D / G / D+G) on the synthetic TUM-analogue presets, plus RPE, tracking and time.
 #
 #   bench/ablation.sh [--bin DIR] [--frames N] [--runs R] [--presets "a b c"] [--modes "..."]
-#                     [--out DIR] [--seed S] [--timeout SEC] [--table-only]
+#                     [--out DIR] [--seed S] [--timeout SEC] [--realtime] [--table-only]
+#
+# --realtime paces the frames at the sequence's 30 Hz as a camera (or ORB-SLAM2's rgbd_tum
+# example) does; without it frames are fed as fast as the system takes them, and the modes
+# that run the detector leave local mapping less CPU per frame than mode off.
 #
 # A mode may carry suffixes, each starting with ':' (e.g. "detect+geometry:gt:noveto"):
 #   :gt       person boxes from the sequence's ground-truth boxes.txt instead of the detector
@@ -30,9 +34,10 @@ out="$repo/out/ablation"
 seed=1
 timeout_s=3600
 table_only=0
+pace=()
 
 usage() {
-  sed -n '2,15p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "${BASH_SOURCE[0]}"
   echo "defaults: --bin build/ws/devel/lib/yolo_slam --frames 0 (preset length) --runs 3 --seed 1"
   echo "          --presets \"$presets\""
   echo "          --modes \"$modes\" --out out/ablation --timeout 3600 (per run, seconds)"
@@ -51,6 +56,7 @@ while [ $# -gt 0 ]; do
     --out) need "$@"; out="$2"; shift 2 ;;
     --seed) need "$@"; posint "$1" "$2" 0; seed="$2"; shift 2 ;;
     --timeout) need "$@"; posint "$1" "$2" 1; timeout_s="$2"; shift 2 ;;
+    --realtime) pace=(--realtime); shift ;;
     --table-only) table_only=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "error: unknown option '$1'; see --help" >&2; exit 1 ;;
@@ -98,7 +104,7 @@ log() { echo "[$(date +%H:%M:%S)] $*"; }
 
 # Everything needed to reproduce the table, read back by ablation_table.py.
 {
-  echo "command: bench/ablation.sh --frames $frames --runs $runs --presets \"$presets\" --modes \"$modes\" --seed $seed"
+  echo "command: bench/ablation.sh --frames $frames --runs $runs --presets \"$presets\" --modes \"$modes\" --seed $seed${pace[*]:+ ${pace[*]}}"
   echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
   echo "commit: $(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$repo" diff --quiet HEAD -- src include tools 2>/dev/null || echo ' (+uncommitted changes in src/include/tools)')"
   echo "bin: $bin (yolo_slam_run built $(date -u -r "$bin/yolo_slam_run" +%Y-%m-%dT%H:%M:%SZ 2>/dev/null || echo '?'))"
@@ -136,7 +142,7 @@ if [ "$table_only" = 0 ]; then
         echo "$mode" > "$dir/mode.txt"
         t0=$(date +%s)
         timeout -s TERM -k 60 "$timeout_s" "$bin/yolo_slam_run" --sequence "$seq" --config "$seq/camera.yaml" \
-          --out "$dir" --dynamic-mode "$base" "${extra[@]}" > "$dir/run.log" 2>&1
+          --out "$dir" --dynamic-mode "$base" "${extra[@]}" "${pace[@]}" > "$dir/run.log" 2>&1
         rc=$?
         echo "$rc" > "$dir/rc.txt"
         if [ "$rc" = 0 ] && [ -s "$dir/CameraTrajectory.txt" ]; then

@@ -50,7 +50,7 @@ const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
 const char* kUsage =
     "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
-    "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt]\n"
+    "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
     "                     [--static-box-veto on|off]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
@@ -75,7 +75,8 @@ const char* kUsage =
     "                     package's vocab/yolo_slam_orb_k10_L4.vocab when it exists\n"
     "  --no-vocabulary    run without BoW: no BoW matching, relocalisation or loop closing\n"
     "  --boxes-from-gt    person boxes from the sequence's boxes.txt (synthetic ground truth)\n"
-    "                     instead of running the detector\n"
+    "                     instead of running the detector\n"    "  --boxes FILE       replay the detector's boxes of an earlier run (its OUT/boxes_screened.txt,\n"
+    "                     with their scores) instead of running the detector\n"
     "  --track-boxes B    override Screening.trackBoxes: on carries person boxes over frames\n"
     "                     where the detector misses them (modes detect, detect+geometry);\n"
     "                     screening metrics count the boxes actually screened\n"
@@ -88,7 +89,7 @@ const char* kUsage =
 
 struct Args {
   std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes,
-      propagate_labels, static_box_veto;
+      propagate_labels, static_box_veto, boxes_file;
   long max_frames = -1;
   bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false;
 };
@@ -110,6 +111,7 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
     else if (s == "--realtime") a.realtime = true;
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
+    else if (s == "--boxes") a.boxes_file = need(i, s);
     else if (s == "--propagate-labels") {
       a.propagate_labels = need(i, s);
       if (a.propagate_labels != "on" && a.propagate_labels != "off")
@@ -138,6 +140,7 @@ Args parseArgs(int argc, char** argv) {
   if (a.sequence.empty() || a.out.empty())
     throw Error(std::string("--sequence and --out are required\n") + kUsage);
   if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
+  if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
   if (a.config.empty()) {
     // yolo_slam_synth writes camera.yaml beside the images; real TUM folders need --config.
     a.config = joinPath(a.sequence, "camera.yaml");
@@ -155,22 +158,31 @@ Args parseArgs(int argc, char** argv) {
   return a;
 }
 
-// boxes.txt of a synthetic sequence: "rgb_stamp id class x1 y1 x2 y2 visible_fraction".
-// Person boxes only (what the detector is asked for), keyed by the stamp in microseconds.
-std::map<long long, detection::Boxes> readGtBoxes(const std::string& path) {
+// Person boxes per frame from a file, keyed by the stamp in microseconds. Two formats:
+// - ground truth: a synthetic sequence's boxes.txt, "rgb_stamp id class x1 y1 x2 y2
+//   visible_fraction"; persons only (what the detector is asked for), score 1;
+// - replay: a run's boxes_screened.txt, "rgb_stamp index label x1 y1 x2 y2 score tracked";
+//   the detector's boxes with their scores (rows with tracked 1 were carried by the box tracker,
+//   which carries them again in this run).
+std::map<long long, detection::Boxes> readBoxFile(const std::string& path, bool replay) {
   if (!fileExists(path))
-    throw Error(path + ": not found; --boxes-from-gt needs a synthetic sequence (yolo_slam_synth writes boxes.txt)");
+    throw Error(path + (replay ? ": not found; --boxes needs a boxes_screened.txt written by yolo_slam_run"
+                               : ": not found; --boxes-from-gt needs a synthetic sequence (yolo_slam_synth writes boxes.txt)"));
   std::map<long long, detection::Boxes> out;
   for (const auto& row : io::readTextTable(path)) {
-    if (row.fields.size() < 7) io::throwAtLine(path, row.line, "expected 'stamp id class x1 y1 x2 y2 [visible]'");
+    if (replay && row.fields.size() < 9)
+      io::throwAtLine(path, row.line, "expected 'rgb_stamp index label x1 y1 x2 y2 score tracked'");
+    if (!replay && row.fields.size() < 7)
+      io::throwAtLine(path, row.line, "expected 'stamp id class x1 y1 x2 y2 [visible]'");
     const double stamp = io::parseFiniteDouble(row.fields[0], path, row.line, "stamp");
-    if (row.fields[2] != "person") continue;
+    if (!replay && row.fields[2] != "person") continue;
+    if (replay && row.fields[8] != "0") continue;
     double c[4];
     for (int k = 0; k < 4; ++k) c[k] = io::parseFiniteDouble(row.fields[3 + k], path, row.line, "box corner");
     detection::Box b;
     b.class_id = 0;
-    b.label = "person";
-    b.score = 1.f;
+    b.label = row.fields[2];
+    b.score = replay ? static_cast<float>(io::parseFiniteDouble(row.fields[7], path, row.line, "score")) : 1.f;
     b.rect = cv::Rect2f(static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2] - c[0]),
                         static_cast<float>(c[3] - c[1]));
     out[std::llround(stamp * 1e6)].push_back(b);
@@ -243,10 +255,6 @@ void makeDirs(const std::string& dir) {
   if (!dirExists(dir)) throw Error(dir + ": cannot create the output folder; check the path and permissions");
 }
 
-std::string summaryField(const char* name, const std::vector<double>& v) {
-  return std::string("    \"") + name + "\": " + summaryJsonMs(summarize(v));
-}
-
 int run(const Args& args) {
   Config cfg = Config::fromFile(args.config);
   CameraModel cam = CameraModel::load(cfg);
@@ -267,8 +275,11 @@ int run(const Args& args) {
   std::string detector_name = "none";
   if (needs_boxes) {
     if (args.boxes_from_gt) {
-      gt_boxes = readGtBoxes(joinPath(args.sequence, "boxes.txt"));
+      gt_boxes = readBoxFile(joinPath(args.sequence, "boxes.txt"), false);
       detector_name = "ground-truth boxes.txt";
+    } else if (!args.boxes_file.empty()) {
+      gt_boxes = readBoxFile(args.boxes_file, true);
+      detector_name = args.boxes_file;
     } else {
       detection::DetectorOptions dopt = detection::DetectorOptions::load(cfg);
       if (!args.model.empty()) dopt.model = args.model;
@@ -426,44 +437,25 @@ int run(const Args& args) {
   js << "{\n  \"sequence\": \"" << jsonEscape(args.sequence) << "\",\n  \"config\": \"" << jsonEscape(args.config)
      << "\",\n  \"dynamic_mode\": \"" << screening::toString(mode) << "\",\n  \"boxes\": \""
      << jsonEscape(detector_name) << "\",\n  \"interrupted\": " << (g_stop ? "true" : "false")
-     << ",\n  \"frames\": " << s.frames << ",\n  \"frames_skipped\": " << skipped
-     << ",\n  \"tracked\": " << s.tracked << ",\n  \"lost\": " << s.lost
-     << ",\n  \"trajectory_poses\": " << traj.size() << ",\n  \"keyframes\": " << s.keyframes
-     << ",\n  \"keyframes_culled\": " << s.keyframes_culled << ",\n  \"map_points\": " << s.map_points
-     << ",\n  \"map_resets\": " << s.resets << ",\n  \"relocalizations\": " << s.relocalizations
-     << ",\n  \"loops_closed\": " << s.loops_closed << ",\n  \"global_bundle_adjustments\": " << s.global_bas
+     << ",\n  \"frames_skipped\": " << skipped << ",\n  \"trajectory_poses\": " << traj.size()
      << ",\n  \"ate_rmse_m\": " << jsonNumber(ate_rmse, 6)
      << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
-     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4)
-     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-     << ", \"dropped\": " << s.keypoints_dropped << ", \"propagated\": " << s.keypoints_propagated
-     << ", \"vetoed\": " << s.keypoints_vetoed << "}"
-     << ",\n  \"temporal\": {\"matched\": " << s.temporal_matched
-     << ", \"static_consistent\": " << s.temporal_static_consistent
-     << ", \"motion_frames\": " << s.temporal_motion_frames
-     << ", \"boxes_vetoed\": " << s.boxes_vetoed << "}"
+     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4) << ",\n"
+     << slam::statsCountsJson(s)
      << ",\n  \"track_boxes\": " << (sys_opt.screening.track_boxes && needs_boxes ? "true" : "false")
      << ",\n  \"propagate_labels\": "
      << (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off ? "true" : "false")
      << ",\n  \"static_box_veto\": "
      << (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off ? "true" : "false")
-     << ",\n  \"boxes_screened\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
      << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
-     << ",\n  \"screening_metrics\": " << metrics.json();
-  std::vector<double> et;
-  for (size_t k = 0; k < s.tracking_ms.size() && k < s.extraction_ms.size(); ++k)
-    et.push_back(s.extraction_ms[k] + s.tracking_ms[k]);
-  js << ",\n  \"timings\": {\n" << summaryField("extraction", s.extraction_ms) << ",\n"
-     << summaryField("screening", s.screening_ms) << ",\n" << summaryField("tracking", s.tracking_ms) << ",\n"
-     << summaryField("extraction_plus_tracking", et) << ",\n"
-     << summaryField("local_mapping", s.local_mapping_ms) << ",\n"
-     << summaryField("detection", s.detection_ms) << ",\n" << summaryField("frame", frame_ms) << "\n  }\n}\n";
+     << ",\n  \"screening_metrics\": " << metrics.json() << ",\n"
+     << slam::statsTimingsJson(s, {{"frame", frame_ms}}) << "\n}\n";
   const std::string stats_path = joinPath(args.out, "stats.json");
   io::writeFileAtomic(stats_path, js.str());
 
   std::printf("frames %zu, tracked %zu, lost %zu, keyframes %zu, map points %zu\n", s.frames, s.tracked, s.lost,
               s.keyframes, s.map_points);
-  const auto t = summarize(et);
+  const auto t = summarize(slam::extractionPlusTrackingMs(s));
   std::printf("extraction+tracking median %.2f ms, p95 %.2f ms; %.1f frames/s overall\n", t.median, t.p95,
               total_s > 0 ? (processed + skipped) / total_s : 0.0);
   if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);

@@ -323,29 +323,50 @@ SystemStats System::stats() const {
   return s;
 }
 
-std::string System::statsJson() const {
-  SystemStats s = stats();
+std::string statsCountsJson(const SystemStats& s) {
   std::ostringstream o;
-  o << "{\n  \"frames\": " << s.frames << ",\n  \"tracked\": " << s.tracked
-    << ",\n  \"lost\": " << s.lost << ",\n  \"keyframes\": " << s.keyframes
-    << ",\n  \"keyframes_culled\": " << s.keyframes_culled
-    << ",\n  \"map_points\": " << s.map_points << ",\n  \"resets\": " << s.resets
+  o << "  \"frames\": " << s.frames << ",\n  \"tracked\": " << s.tracked << ",\n  \"lost\": " << s.lost
+    << ",\n  \"keyframes\": " << s.keyframes << ",\n  \"keyframes_culled\": " << s.keyframes_culled
+    << ",\n  \"map_points\": " << s.map_points << ",\n  \"map_resets\": " << s.resets
     << ",\n  \"relocalizations\": " << s.relocalizations << ",\n  \"loops_closed\": " << s.loops_closed
     << ",\n  \"global_bundle_adjustments\": " << s.global_bas
     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
     << ", \"dropped\": " << s.keypoints_dropped << ", \"propagated\": " << s.keypoints_propagated
     << ", \"vetoed\": " << s.keypoints_vetoed << "}"
-    << ",\n  \"boxes\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked << "}"
-    << ",\n  \"timings\": {\n    \"extraction\": " << summaryJsonMs(summarize(s.extraction_ms))
-    << ",\n    \"screening\": " << summaryJsonMs(summarize(s.screening_ms))
-    << ",\n    \"tracking\": " << summaryJsonMs(summarize(s.tracking_ms));
-  std::vector<double> et;
-  if (s.extraction_ms.size() == s.tracking_ms.size())
-    for (size_t i = 0; i < s.tracking_ms.size(); ++i) et.push_back(s.extraction_ms[i] + s.tracking_ms[i]);
-  o << ",\n    \"extraction_plus_tracking\": " << summaryJsonMs(summarize(et))
-    << ",\n    \"local_mapping\": " << summaryJsonMs(summarize(s.local_mapping_ms))
-    << ",\n    \"detection\": " << summaryJsonMs(summarize(s.detection_ms)) << "\n  }\n}\n";
+    << ",\n  \"temporal\": {\"matched\": " << s.temporal_matched
+    << ", \"static_consistent\": " << s.temporal_static_consistent
+    << ", \"motion_frames\": " << s.temporal_motion_frames << ", \"boxes_vetoed\": " << s.boxes_vetoed << "}"
+    << ",\n  \"boxes_screened\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked
+    << "}";
   return o.str();
+}
+
+std::vector<double> extractionPlusTrackingMs(const SystemStats& s) {
+  std::vector<double> et;
+  for (size_t k = 0; k < s.tracking_ms.size() && k < s.extraction_ms.size(); ++k)
+    et.push_back(s.extraction_ms[k] + s.tracking_ms[k]);
+  return et;
+}
+
+std::string statsTimingsJson(const SystemStats& s,
+                             const std::vector<std::pair<std::string, std::vector<double>>>& extra) {
+  const std::vector<double> et = extractionPlusTrackingMs(s);
+  std::vector<std::pair<std::string, const std::vector<double>*>> stages = {
+      {"extraction", &s.extraction_ms}, {"screening", &s.screening_ms},
+      {"tracking", &s.tracking_ms},     {"extraction_plus_tracking", &et},
+      {"local_mapping", &s.local_mapping_ms}, {"detection", &s.detection_ms}};
+  for (const auto& e : extra) stages.emplace_back(e.first, &e.second);
+  std::ostringstream o;
+  o << "  \"timings\": {";
+  for (size_t k = 0; k < stages.size(); ++k)
+    o << (k ? ",\n    \"" : "\n    \"") << stages[k].first << "\": " << summaryJsonMs(summarize(*stages[k].second));
+  o << "\n  }";
+  return o.str();
+}
+
+std::string System::statsJson() const {
+  const SystemStats s = stats();
+  return "{\n" + statsCountsJson(s) + ",\n" + statsTimingsJson(s) + "\n}\n";
 }
 
 }  // namespace slam

@@ -176,6 +176,48 @@ TEST_F(RunnerMetrics, GroundTruthBoxesGiveHighRecall) {
   EXPECT_EQ(lineCount(joinPath(out, "CameraTrajectory.txt")), jsonNumberOf(js, "trajectory_poses"));
 }
 
+// The detector's rows of a boxes_screened.txt (tracked 0), with the header dropped.
+static std::vector<std::string> detectedRows(const std::string& path) {
+  std::vector<std::string> rows;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#' && line.size() > 2 && line.compare(line.size() - 2, 2, " 0") == 0)
+      rows.push_back(line);
+  return rows;
+}
+
+TEST_F(RunnerMetrics, ReplayedBoxesAreTheBoxesOfTheFirstRun) {
+  const std::string first = joinPath(dir_, "out_replay_src"), second = joinPath(dir_, "out_replay");
+  std::string so, se;
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", first, "--boxes-from-gt", "--no-vocabulary", "--max-frames", "8"},
+                    joinPath(dir_, "replay_src"), so, se),
+            0)
+      << so << se;
+  const std::vector<std::string> want = detectedRows(joinPath(first, "boxes_screened.txt"));
+  ASSERT_GT(want.size(), 4u);
+  const std::string replay = joinPath(first, "boxes_screened.txt");
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", second, "--boxes", replay, "--no-vocabulary", "--max-frames", "8"},
+                    joinPath(dir_, "replay"), so, se),
+            0)
+      << so << se;
+  EXPECT_NE(se.find("boxes: " + replay), std::string::npos) << se;
+  EXPECT_EQ(detectedRows(joinPath(second, "boxes_screened.txt")), want);
+  const std::string js = readAll(joinPath(second, "stats.json"));
+  EXPECT_EQ(jsonNumberOf(jsonObject(js, "boxes_screened"), "detected"), static_cast<double>(want.size())) << js;
+
+  // A file in the other format (boxes.txt has no score/tracked columns): the error names it.
+  ASSERT_NE(runTool({"--sequence", seq(), "--out", second, "--boxes", joinPath(seq(), "boxes.txt"),
+                     "--no-vocabulary", "--max-frames", "2"},
+                    joinPath(dir_, "replay_bad"), so, se),
+            0);
+  EXPECT_NE(se.find(joinPath(seq(), "boxes.txt")), std::string::npos) << se;
+  EXPECT_NE(se.find("score tracked"), std::string::npos) << se;
+  ASSERT_NE(runTool({"--sequence", seq(), "--out", second, "--boxes", replay, "--boxes-from-gt"},
+                    joinPath(dir_, "replay_both"), so, se),
+            0);
+  EXPECT_NE(se.find("exclude each other"), std::string::npos) << se;
+}
+
 TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   const std::string out = joinPath(dir_, "out_off");
   std::string so, se;

@@ -115,4 +115,10 @@ TEST(SlamSystem, ResetAndLocalizationMode) {
   EXPECT_EQ(sys.trackRgbd(img, plane, 1.0, {}).state, TrackingState::Ok);
   const std::string js = sys.statsJson();
   EXPECT_NE(js.find("\"frames\": 7"), std::string::npos) << js;
+  // The members yolo_slam_run's stats.json shares: counts, screening sections, timings.
+  for (const char* key : {"\"map_resets\"", "\"keypoints\": {", "\"temporal\": {", "\"boxes_screened\": {",
+                          "\"timings\": {", "\"extraction_plus_tracking\": {"})
+    EXPECT_NE(js.find(key), std::string::npos) << key << " missing in " << js;
+  EXPECT_EQ(js.back(), '\n');
+  EXPECT_EQ(js.find(",\n}"), std::string::npos) << "trailing comma in " << js;
 }

@@ -59,6 +59,19 @@ struct SystemStats {
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
 };
 
+// Per frame: extraction_ms + tracking_ms (the tracking thread's share of a frame).
+std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
+
+// The stats.json members of System::statsJson, shared with yolo_slam_run's stats.json: JSON
+// members without the enclosing braces, two-space indented, no trailing comma.
+// Counts: frames, tracked, lost, keyframes, keyframes_culled, map_points, map_resets,
+// relocalizations, loops_closed, global_bundle_adjustments, keypoints {...}, temporal {...},
+// boxes_screened {...}.
+std::string statsCountsJson(const SystemStats& s);
+// "timings": median/p95/... (ms) per stage, then `extra` stages measured by the caller.
+std::string statsTimingsJson(const SystemStats& s,
+                             const std::vector<std::pair<std::string, std::vector<double>>>& extra = {});
+
 // Everything System reads from the settings file, in one place (tools override fields, e.g. the
 // runner's --dynamic-mode, before constructing the System).
 struct SystemOptions {
