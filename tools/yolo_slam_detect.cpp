@@ -21,7 +21,7 @@ namespace {
 
 const char* kUsage =
     "usage: yolo_slam_detect [--model DIR_OR_CFG_OR_ONNX] [--json] [--draw OUT.png | --draw-dir DIR]\n"
-    "                        [--conf T] [--nms T] [--size WxH] [--letterbox] [--threads N]\n"
+    "                        [--conf T] [--nms T] [--size WxH] [--no-letterbox] [--threads N]\n"
     "                        [--classes a,b,...] IMAGE...\n"
     "Prints the boxes of the dynamic classes (default: person) found in each image.\n"
     "  --model      model folder, .cfg or .onnx (default: $YOLO_SLAM_MODEL, else\n"
@@ -30,7 +30,9 @@ const char* kUsage =
     "  --draw       write the boxes drawn on the image to OUT.png (one image only)\n"
     "  --draw-dir   write <DIR>/<image name>.png for every image\n"
     "  --conf/--nms confidence (0.3) and NMS IoU (0.45) thresholds\n"
-    "  --size       network input size, multiple of 32 (default: the model's own)\n";
+    "  --size       network input size, multiple of 32 (default: the model's own)\n"
+    "  --no-letterbox  stretch the image to the input size instead of letterboxing it (the\n"
+    "               default keeps the aspect ratio, as Detector.letterbox: 1)\n";
 
 std::string baseName(const std::string& path) {
   size_t slash = path.find_last_of('/');
@@ -74,8 +76,8 @@ int run(int argc, char** argv) {
       opt.nms_threshold = parseFloat(a, value());
     } else if (a == "--threads") {
       opt.threads = int(parseFloat(a, value()));
-    } else if (a == "--letterbox") {
-      opt.letterbox = true;
+    } else if (a == "--no-letterbox") {
+      opt.letterbox = false;
     } else if (a == "--size") {
       std::string v = value();
       if (std::sscanf(v.c_str(), "%dx%d", &opt.input_width, &opt.input_height) != 2)
