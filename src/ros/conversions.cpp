@@ -76,6 +76,8 @@ void toMsg(const features::FeatureFrame& f, const detection::Boxes& boxes, Keypo
   msg.depth.resize(n, 0.f);
   msg.dynamic.assign(f.dynamic.begin(), f.dynamic.end());
   msg.dynamic.resize(n, 0);
+  if (f.motion.size() == n) msg.motion.assign(f.motion.begin(), f.motion.end());
+  else msg.motion.clear();
   msg.boxes.clear();
   msg.boxes.reserve(boxes.size());
   for (const auto& b : boxes) msg.boxes.push_back(toMsg(b));
@@ -119,6 +121,7 @@ features::FeatureFrame fromMsg(const KeypointFrame& msg, const CameraModel& cam)
   if (n > 0) std::memcpy(f.descriptors.data, msg.descriptors.data(), n * 32);
   f.depth.assign(msg.depth.begin(), msg.depth.end());
   f.dynamic.assign(msg.dynamic.begin(), msg.dynamic.end());
+  if (msg.motion.size() == n) f.motion.assign(msg.motion.begin(), msg.motion.end());
   f.right_u.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const float d = f.depth[i];

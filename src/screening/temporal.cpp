@@ -211,6 +211,7 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
       ++st.propagated;
     }
   }
+  frame.motion = verdict;
   // This frame becomes the previous one.
   prev_.keypoints = frame.keypoints;
   prev_.descriptors = frame.descriptors.clone();

@@ -64,6 +64,8 @@ Frame::Frame(const features::FeatureFrame& ff, const CameraModel& camera, const 
   depth.assign(N, -1.f);
   right_u.assign(N, -1.f);
   dynamic.assign(N, 0);
+  if (ff.motion.size() == static_cast<size_t>(N)) motion.assign(ff.motion.begin(), ff.motion.end());
+  else motion.clear();
   for (int i = 0; i < N; ++i) {
     if (static_cast<size_t>(i) < ff.depth.size()) {
       float d = ff.depth[i];

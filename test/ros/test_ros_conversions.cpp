@@ -54,6 +54,7 @@ static features::FeatureFrame makeFrame(size_t n) {
     f.keypoints.push_back(k);
     f.depth.push_back(i % 3 == 0 ? 0.f : 1.0f + 0.1f * i);
     f.dynamic.push_back(i % 4 == 0 ? 1 : 0);
+    f.motion.push_back(static_cast<int8_t>(static_cast<int>(i % 3) - 1));
     for (int j = 0; j < 32; ++j) f.descriptors.at<uint8_t>(static_cast<int>(i), j) = static_cast<uint8_t>(i * 32 + j);
   }
   f.keypoints_un = f.keypoints;
@@ -69,10 +70,12 @@ TEST(Conversions, KeypointFrameRoundTrip) {
   msg.header.stamp = ros::Time(12.5);
   ros1::toMsg(f, {b}, msg);
   EXPECT_EQ(msg.keypoints.size(), 50u);
+  EXPECT_EQ(msg.motion.size(), 50u);
   EXPECT_EQ(msg.descriptors.size(), 50u * 32);
   EXPECT_EQ(msg.boxes.size(), 1u);
   CameraModel cam;  // no distortion
   const features::FeatureFrame g = ros1::fromMsg(msg, cam);
+  ASSERT_EQ(g.motion.size(), 50u);
   EXPECT_DOUBLE_EQ(g.stamp, 12.5);
   EXPECT_EQ(g.width, 640);
   ASSERT_EQ(g.size(), 50u);
@@ -84,6 +87,7 @@ TEST(Conversions, KeypointFrameRoundTrip) {
     EXPECT_EQ(g.keypoints_un[i].pt, f.keypoints[i].pt);
     EXPECT_EQ(g.depth[i], f.depth[i]);
     EXPECT_EQ(g.dynamic[i], f.dynamic[i]);
+    EXPECT_EQ(g.motion[i], f.motion[i]);
     if (f.depth[i] > 0)
       EXPECT_NEAR(g.right_u[i], f.keypoints[i].pt.x - cam.bf / f.depth[i], 1e-4);
     else

@@ -8,6 +8,8 @@
 #include "yolo_slam/screening/screener.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 
 #include <random>
@@ -116,6 +118,11 @@ TEST(Temporal, StaticSceneIsStaticConsistentUnderCameraMotion) {
   EXPECT_EQ(st.matched, 200);
   EXPECT_EQ(st.static_consistent, 200);
   EXPECT_EQ(st.propagated, 0);
+  // The per-keypoint verdict travels with the frame (tracking reads it).
+  ASSERT_EQ(f1.motion.size(), f1.size());
+  EXPECT_EQ(std::count(f1.motion.begin(), f1.motion.end(), int8_t{1}), 200);
+  ASSERT_EQ(f0.motion.size(), f0.size());  // first frame: nothing to compare with
+  EXPECT_EQ(std::count(f0.motion.begin(), f0.motion.end(), int8_t{-1}), 200);
 }
 
 TEST(Temporal, LabelsOfAMovingPersonPropagateWhereTheDetectorMissedThem) {

@@ -21,6 +21,10 @@ struct FeatureFrame {
   // ORB-SLAM2. Test depth > 0, not right_u, for "has depth".
   std::vector<float> right_u;
   std::vector<uint8_t> dynamic;              // 1 = screened as dynamic (never used by SLAM)
+  // Frame-to-frame motion test per keypoint (screening/temporal.h): 1 where a static point
+  // would be, 0 moved, -1 untested; empty when the test did not run. Tracking marks a map point
+  // dynamic only on evidence that is not "static-consistent".
+  std::vector<int8_t> motion;
 
   size_t size() const { return keypoints.size(); }
   size_t countDynamic() const {

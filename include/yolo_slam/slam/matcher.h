@@ -16,12 +16,16 @@ namespace matcher {
 
 constexpr int kThHigh = 100;
 constexpr int kThLow = 50;
+// searchProjections reports a map point as on a moving object only if the dynamic keypoint it
+// matches is within this fraction of the point's predicted depth (a nearer keypoint hides it).
+constexpr double kDynamicDepthTolerance = 0.1;
 constexpr int kHistLength = 30;
 
 // A map point projected into a frame (ORB-SLAM2 isInFrustum results).
 struct Projection {
   MapPointPtr mp;
   double u = 0, v = 0, ur = -1;  // pixel, virtual right coordinate
+  double z = -1;                 // predicted depth in the frame (m); <= 0 unknown
   int level = 0;                 // predicted pyramid level
   double view_cos = 1;           // cosine between viewing ray and the point's mean normal
 };
@@ -37,7 +41,9 @@ int searchLastFrame(Frame& F, const Frame& last, double th);
 
 // Local-map search (ORB-SLAM2 SearchByProjection(Frame, vector<MapPoint*>)): radius th *
 // (2.5 or 4 by viewing angle) * scale(predicted level), ratio test between the two best
-// distances when on the same level. Points whose best candidate is a *dynamic* keypoint are
+// distances when on the same level. Points whose best candidate is a *dynamic* keypoint at
+// their own depth (within kDynamicDepthTolerance, or without depth) that the frame-to-frame
+// test saw move (Frame::motion 0; any dynamic keypoint when the test did not run) are
 // appended to `dynamic_hits` (if given) instead of being matched.
 int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, double nn_ratio,
                       std::vector<MapPointPtr>* dynamic_hits = nullptr);
