@@ -15,7 +15,8 @@
 #   :notrack  no box tracking between detections (--track-boxes off)
 #   :veto / :noveto   static-box veto on / off (--static-box-veto)
 #   :prop / :noprop   label propagation on / off (--propagate-labels)
-# ":notrack:noveto:noprop" is the paper's method as printed.
+#   :single   the main detection model alone, without Detector.extraModels (--single-model)
+# ":notrack:noveto:noprop:single" is the paper's method as printed.
 # Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
 # OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
 # evaluated with yolo_slam_eval (ATE, RPE delta 1 s); bench/ablation_table.py takes the medians
@@ -78,6 +79,7 @@ suffix_options() {
       noveto) extra+=(--static-box-veto off) ;;
       prop) extra+=(--propagate-labels on) ;;
       noprop) extra+=(--propagate-labels off) ;;
+      single) extra+=(--single-model) ;;
       *) return 1 ;;
     esac
   done
@@ -88,7 +90,7 @@ for m in $modes; do
     off|detect|geometry|detect+geometry) ;;
     *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
-  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop" >&2; exit 1; }
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :single" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,12 +21,16 @@ using namespace yolo_slam;
 namespace {
 
 const char* kUsage =
-    "usage: yolo_slam_detect [--model DIR_OR_CFG_OR_ONNX] [--json] [--draw OUT.png | --draw-dir DIR]\n"
-    "                        [--conf T] [--nms T] [--size WxH] [--no-letterbox] [--threads N]\n"
-    "                        [--classes a,b,...] IMAGE...\n"
-    "Prints the boxes of the dynamic classes (default: person) found in each image.\n"
-    "  --model      model folder, .cfg or .onnx (default: $YOLO_SLAM_MODEL, else\n"
+    "usage: yolo_slam_detect [--model DIR_OR_CFG_OR_ONNX] [--extra-model M ... | --single-model]\n"
+    "                        [--json] [--draw OUT.png | --draw-dir DIR] [--conf T] [--nms T]\n"
+    "                        [--size WxH] [--no-letterbox] [--threads N] [--classes a,b,...] IMAGE...\n"
+    "Prints the boxes of the dynamic classes (default: person, body) found in each image by the\n"
+    "same detector the pipeline runs (main model plus extra models, boxes merged).\n"
+    "  --model      main model folder, .cfg or .onnx (default: $YOLO_SLAM_MODEL, else\n"
     "               <shared>/models/mnv2-yolov3-nano-voc)\n"
+    "  --extra-model  a model run beside the main one (repeatable; replaces the default extra\n"
+    "               model <shared>/models/yolo-fastest-1.1-body, as Detector.extraModels)\n"
+    "  --single-model  the main model alone (Detector.extraModels: \"\")\n"
     "  --json       print [{\"image\":..,\"boxes\":[{\"class\",\"score\",\"x1\",\"y1\",\"x2\",\"y2\"}]}]\n"
     "  --draw       write the boxes drawn on the image to OUT.png (one image only)\n"
     "  --draw-dir   write <DIR>/<image name>.png for every image\n"
@@ -50,7 +55,7 @@ float parseFloat(const std::string& flag, const std::string& v) {
 
 int run(int argc, char** argv) {
   detection::DetectorOptions opt;
-  bool json = false;
+  bool json = false, extra_given = false, single = false;
   std::string draw, draw_dir;
   std::vector<std::string> images;
   for (int i = 1; i < argc; ++i) {
@@ -64,6 +69,15 @@ int run(int argc, char** argv) {
       return 0;
     } else if (a == "--model") {
       opt.model = value();
+    } else if (a == "--extra-model") {
+      if (single) throw Error("--single-model and --extra-model exclude each other");
+      if (!extra_given) opt.extra_models.clear();
+      extra_given = true;
+      opt.extra_models.push_back(value());
+    } else if (a == "--single-model") {
+      if (extra_given) throw Error("--single-model and --extra-model exclude each other");
+      single = true;
+      opt.extra_models.clear();
     } else if (a == "--json") {
       json = true;
     } else if (a == "--draw") {
@@ -113,13 +127,13 @@ int run(int argc, char** argv) {
   if (!draw_dir.empty() && !dirExists(draw_dir))
     throw Error("--draw-dir " + draw_dir + " is not an existing folder; create it first");
 
-  detection::YoloDetector detector(opt);
-  if (!json) std::cout << "# model: " << detector.description() << "\n";
+  std::unique_ptr<detection::Detector> detector = detection::makeDetector(opt);
+  if (!json) std::cout << "# model: " << detector->description() << "\n";
   if (json) std::cout << "[";
   for (size_t i = 0; i < images.size(); ++i) {
     cv::Mat img = cv::imread(images[i], cv::IMREAD_COLOR);
     if (img.empty()) throw Error("cannot read image " + images[i] + "; check the path and format");
-    detection::Boxes boxes = detector.detect(img);
+    detection::Boxes boxes = detector->detect(img);
     if (json) {
       std::cout << (i ? ",\n " : "") << "{\"image\":\"" << jsonEscape(images[i])
                 << "\",\"boxes\":" << detection::boxesJson(boxes) << "}";

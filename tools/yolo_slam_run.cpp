@@ -50,6 +50,7 @@ const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
 const char* kUsage =
     "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
+    "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
     "                     [--static-box-veto on|off]\n"
@@ -70,7 +71,9 @@ const char* kUsage =
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
     "  --dynamic-mode M   override Screening.mode of the config: off, detect, geometry or\n"
     "                     detect+geometry (the paper's method)\n"
-    "  --model DIR        detector model (folder, .cfg or .onnx); default Detector.model\n"
+    "  --model DIR        main detector model (folder, .cfg or .onnx); default Detector.model\n"
+    "                     (Detector.extraModels still run beside it)\n"
+    "  --single-model     run the main model alone (Detector.extraModels: \"\")\n"
     "  --vocabulary FILE  ORB vocabulary (binary or ORBvoc.txt) for BoW matching; default the\n"
     "                     package's vocab/yolo_slam_orb_k10_L4.vocab when it exists\n"
     "  --no-vocabulary    run without BoW: no BoW matching, relocalisation or loop closing\n"
@@ -91,7 +94,8 @@ struct Args {
   std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes,
       propagate_labels, static_box_veto, boxes_file;
   long max_frames = -1;
-  bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false;
+  bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
+       single_model = false;
 };
 
 Args parseArgs(int argc, char** argv) {
@@ -106,6 +110,7 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--config") a.config = need(i, s);
     else if (s == "--out") a.out = need(i, s);
     else if (s == "--model") a.model = need(i, s);
+    else if (s == "--single-model") a.single_model = true;
     else if (s == "--vocabulary") a.vocabulary = need(i, s), a.vocabulary_given = true;
     else if (s == "--no-vocabulary") a.no_vocabulary = true;
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
@@ -283,8 +288,10 @@ int run(const Args& args) {
     } else {
       detection::DetectorOptions dopt = detection::DetectorOptions::load(cfg);
       if (!args.model.empty()) dopt.model = args.model;
+      if (args.single_model) dopt.extra_models.clear();
       detector = detection::makeDetector(dopt);
       detector_name = dopt.model;
+      for (const auto& m : dopt.extra_models) detector_name += " + " + m;
     }
   }
   std::shared_ptr<const vocabulary::Vocabulary> voc;

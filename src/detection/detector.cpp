@@ -23,12 +23,21 @@ std::string defaultModelPath() {
   return joinPath(sharedDir(), "models/mnv2-yolov3-nano-voc");
 }
 
+std::vector<std::string> defaultExtraModelPaths() {
+  return {joinPath(sharedDir(), "models/yolo-fastest-1.1-body")};
+}
+
 DetectorOptions DetectorOptions::load(const Config& cfg) {
   DetectorOptions o;
   // Empty keeps the default (YOLO_SLAM_MODEL or the shared model); a relative path is taken
   // relative to the package folder, like the other files a settings file names.
   const std::string model = cfg.getString("Detector.model", "");
   if (!model.empty()) o.model = model.front() == '/' ? model : joinPath(packageDir(), model);
+  if (cfg.has("Detector.extraModels")) {
+    o.extra_models.clear();
+    for (const auto& m : cfg.getStringList("Detector.extraModels", {}))
+      if (!m.empty()) o.extra_models.push_back(m.front() == '/' ? m : joinPath(packageDir(), m));
+  }
   o.input_width = cfg.getInt("Detector.inputWidth", o.input_width);
   o.input_height = cfg.getInt("Detector.inputHeight", o.input_height);
   o.letterbox = cfg.getBool("Detector.letterbox", o.letterbox);
@@ -253,8 +262,51 @@ std::string YoloDetector::description() const {
          " classes, " + impl_->modelFile();
 }
 
+Boxes mergeOverlapping(Boxes boxes, float iou_threshold) {
+  std::stable_sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) { return a.score > b.score; });
+  Boxes kept;
+  for (const Box& b : boxes) {
+    auto hit = std::find_if(kept.begin(), kept.end(),
+                            [&](const Box& k) { return iou(k.rect, b.rect) > iou_threshold; });
+    if (hit == kept.end()) kept.push_back(b);
+    else hit->rect |= b.rect;
+  }
+  return kept;
+}
+
+MultiModelDetector::MultiModelDetector(const DetectorOptions& options) : merge_iou_(options.nms_threshold) {
+  models_.push_back(std::make_unique<YoloDetector>(options));
+  for (const auto& path : options.extra_models) {
+    DetectorOptions one = options;
+    one.model = path;
+    one.extra_models.clear();
+    try {
+      models_.push_back(std::make_unique<YoloDetector>(one));
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (an entry of Detector.extraModels; set it to \"\" to "
+                  "run the main model alone)");
+    }
+  }
+}
+
+Boxes MultiModelDetector::detect(const cv::Mat& bgr) {
+  Boxes all;
+  for (auto& m : models_) {
+    Boxes b = m->detect(bgr);
+    all.insert(all.end(), b.begin(), b.end());
+  }
+  return mergeOverlapping(std::move(all), merge_iou_);
+}
+
+std::string MultiModelDetector::description() const {
+  std::string d;
+  for (const auto& m : models_) d += (d.empty() ? "" : "; ") + m->description();
+  return d;
+}
+
 std::unique_ptr<Detector> makeDetector(const DetectorOptions& options) {
-  return std::make_unique<YoloDetector>(options);
+  if (options.extra_models.empty()) return std::make_unique<YoloDetector>(options);
+  return std::make_unique<MultiModelDetector>(options);
 }
 
 }  // namespace detection

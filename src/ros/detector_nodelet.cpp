@@ -36,9 +36,8 @@ class DetectorNodelet : public nodelet::Nodelet {
         if (pnh.getParam("conf_threshold", conf)) opt.conf_threshold = static_cast<float>(conf);
         int threads = 0;
         if (pnh.getParam("threads", threads)) opt.threads = threads;
-        auto det = std::make_unique<detection::YoloDetector>(opt);
-        NODELET_INFO("Detector: %s from %s", det->description().c_str(), opt.model.c_str());
-        detector_ = std::move(det);
+        detector_ = detection::makeDetector(opt);
+        NODELET_INFO("Detector: %s", detector_->description().c_str());
       } catch (const std::exception& e) {
         // Without a detector the graph still runs (boxes stay empty, screening finds nothing).
         NODELET_ERROR("Detector: cannot load the model: %s. Publishing empty boxes; fix ~model "

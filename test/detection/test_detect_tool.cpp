@@ -54,6 +54,11 @@ TEST(DetectTool, ErrorsAreOneLine) {
   EXPECT_EQ(out.find('\n'), out.size() - 1) << out;
   EXPECT_EQ(run(tool() + " /nonexistent/image.png", out), 1);
   EXPECT_NE(out.find("error: cannot read image /nonexistent/image.png"), std::string::npos) << out;
+  EXPECT_EQ(run(tool() + " --single-model --extra-model m.cfg x.png", out), 1);
+  EXPECT_NE(out.find("exclude each other"), std::string::npos) << out;
+  EXPECT_EQ(run(tool() + " --extra-model /nonexistent/extra.cfg " + joinPath(sharedDir(), "data/images/person.jpg"), out), 1);
+  EXPECT_NE(out.find("/nonexistent/extra.cfg"), std::string::npos) << out;
+  EXPECT_NE(out.find("Detector.extraModels"), std::string::npos) << out;
   EXPECT_EQ(run(tool() + " --conf abc x.png", out), 1);
   EXPECT_NE(out.find("--conf"), std::string::npos) << out;
 }

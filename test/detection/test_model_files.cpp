@@ -122,7 +122,15 @@ TEST(DetectorOptions, LoadsKeysAndRejectsBadValues) {
 
   DetectorOptions d = DetectorOptions::load(Config());
   EXPECT_EQ(d.model, defaultModelPath());
-  EXPECT_EQ(d.dynamic_classes, std::vector<std::string>{"person"});
+  EXPECT_EQ(d.dynamic_classes, (std::vector<std::string>{"person", "body"}));
+  EXPECT_EQ(d.extra_models, defaultExtraModelPaths());
+
+  // Extra models: "" (or a list of "") means none, relative paths are the package's.
+  EXPECT_TRUE(DetectorOptions::load(Config::fromString("Detector.extraModels: \"\"\n", "x.yaml")).extra_models.empty());
+  EXPECT_TRUE(DetectorOptions::load(Config::fromString("Detector.extraModels: [ \"\" ]\n", "x.yaml")).extra_models.empty());
+  DetectorOptions e = DetectorOptions::load(
+      Config::fromString("Detector.extraModels: [ /abs/a, models/b.cfg ]\n", "x.yaml"));
+  EXPECT_EQ(e.extra_models, (std::vector<std::string>{"/abs/a", joinPath(packageDir(), "models/b.cfg")}));
 
   expectError([] { DetectorOptions::load(Config::fromString("Detector.confThreshold: 1.5\n", "x.yaml")); },
               "Detector.confThreshold");
@@ -142,5 +150,6 @@ TEST(DetectorOptions, DefaultModelFollowsEnvironment) {
 TEST(YoloDetector, UnknownDynamicClassIsAnError) {
   DetectorOptions opt;
   opt.model = joinPath(models(), "yolo-fastest-1.1-body");  // its only class is "body"
+  opt.dynamic_classes = {"person"};
   expectError([&] { YoloDetector d(opt); }, "Detector.dynamicClasses");
 }
