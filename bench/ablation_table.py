@@ -264,7 +264,8 @@ def main():
         o.append(f"| {label(m)} | " + " | ".join(row) + " |")
 
     # Screening keypoints and (when stats.json has them) recall / retention against the masks.
-    o.append("\n### Screening: keypoints dropped per frame (median of runs), dynamic recall / static retention\n")
+    o.append("\n### Screening: keypoints dropped per frame (median of runs), recall on people (on every moving "
+             "object, where the sequence has others) / static retention\n")
     o.append(head)
     o.append(sep)
     for m in modes:
@@ -276,11 +277,14 @@ def main():
                 continue
             drop = c.m(lambda r: ((r["stats"] or {}).get("keypoints", {}).get("dropped", 0) /
                                   max(1, (r["stats"] or {}).get("frames", 1))))
+            prec = c.m(lambda r: find_key(r["stats"], {"person_recall"}))
             rec = c.m(lambda r: find_key(r["stats"], {"dynamic_recall", "recall"}))
             ret = c.m(lambda r: find_key(r["stats"], {"static_retention", "retention"}))
             s = f"{fmt(drop, 0)} dropped"
-            if rec is not None or ret is not None:
-                s += f", recall {fmt(rec, 3)}, retention {fmt(ret, 3)}"
+            if prec is not None and rec is not None and abs(prec - rec) > 5e-4:
+                s += f", recall {fmt(prec, 3)} ({fmt(rec, 3)}), retention {fmt(ret, 3)}"
+            elif rec is not None or ret is not None:
+                s += f", recall {fmt(prec if prec is not None else rec, 3)}, retention {fmt(ret, 3)}"
             row.append(s)
         o.append(f"| {label(m)} | " + " | ".join(row) + " |")
 

@@ -60,7 +60,8 @@ const char* kUsage =
     "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
     "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). On a synthetic sequence\n"
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
-    "keypoints on people's masks and retention of the static keypoints inside the boxes.\n"
+    "keypoints on the masks of people (person_recall) and of every moving object\n"
+    "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
     "Ctrl-C (or SIGTERM) stops at the next frame and still writes everything (exit code 130); a\n"
     "second Ctrl-C quits at once without writing.\n"
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
@@ -239,6 +240,8 @@ struct MetricsAccumulator {
        << ", \"dynamic_recall_in_boxes\": "
        << jsonRatio(sum.dynamic_dropped - sum.dynamic_outside_dropped,
                     sum.dynamic_total - sum.dynamic_outside_boxes)
+       << ", \"person_keypoints\": " << sum.person_total << ", \"person_dropped\": " << sum.person_dropped
+       << ", \"person_recall\": " << jsonRatio(sum.person_dropped, sum.person_total)
        << ", \"static_in_boxes\": " << sum.static_in_boxes << ", \"kept\": " << sum.static_in_boxes_kept
        << ", \"static_retention\": " << jsonRatio(sum.static_in_boxes_kept, sum.static_in_boxes)
        << ", \"static_keypoints\": " << sum.static_total << ", \"static_dropped\": " << sum.static_dropped
@@ -467,9 +470,10 @@ int run(const Args& args) {
               total_s > 0 ? (processed + skipped) / total_s : 0.0);
   if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);
   if (metrics.frames > 0)
-    std::printf("screening vs masks over %zu frames: dynamic recall %s, static retention in boxes %s, "
-                "static dropped %s\n",
+    std::printf("screening vs masks over %zu frames: dynamic recall %s (on people %s), static retention "
+                "in boxes %s, static dropped %s\n",
                 metrics.frames, percent(metrics.sum.dynamic_dropped, metrics.sum.dynamic_total).c_str(),
+                percent(metrics.sum.person_dropped, metrics.sum.person_total).c_str(),
                 percent(metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes).c_str(),
                 percent(metrics.sum.static_dropped, metrics.sum.static_total).c_str());
   if (sys_opt.screening.track_boxes && needs_boxes)

@@ -431,6 +431,10 @@ double ScreeningMetrics::dynamicRecall() const {
   return dynamic_total > 0 ? static_cast<double>(dynamic_dropped) / dynamic_total : 1.0;
 }
 
+double ScreeningMetrics::personRecall() const {
+  return person_total > 0 ? static_cast<double>(person_dropped) / person_total : 1.0;
+}
+
 double ScreeningMetrics::dynamicRecallInBoxes() const {
   const int n = dynamic_total - dynamic_outside_boxes;
   return n > 0 ? static_cast<double>(dynamic_dropped - dynamic_outside_dropped) / n : 1.0;
@@ -445,6 +449,8 @@ ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
   dynamic_dropped += o.dynamic_dropped;
   dynamic_outside_boxes += o.dynamic_outside_boxes;
   dynamic_outside_dropped += o.dynamic_outside_dropped;
+  person_total += o.person_total;
+  person_dropped += o.person_dropped;
   static_in_boxes += o.static_in_boxes;
   static_in_boxes_kept += o.static_in_boxes_kept;
   static_total += o.static_total;
@@ -460,6 +466,8 @@ std::string ScreeningMetrics::toJson() const {
      << ",\"dynamic_outside_boxes\":" << dynamic_outside_boxes
      << ",\"dynamic_outside_dropped\":" << dynamic_outside_dropped
      << ",\"dynamic_recall_in_boxes\":" << dynamicRecallInBoxes()
+     << ",\"person_total\":" << person_total << ",\"person_dropped\":" << person_dropped
+     << ",\"person_recall\":" << personRecall()
      << ",\"static_in_boxes\":" << static_in_boxes
      << ",\"static_in_boxes_kept\":" << static_in_boxes_kept
      << ",\"static_retention\":" << staticRetention() << ",\"static_total\":" << static_total
@@ -499,6 +507,10 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
     if (dyn_gt) {
       ++m.dynamic_total;
       m.dynamic_dropped += dropped ? 1 : 0;
+      if (mask.at<uint8_t>(y, x) == 255) {
+        ++m.person_total;
+        m.person_dropped += dropped ? 1 : 0;
+      }
       if (!in_box) {
         ++m.dynamic_outside_boxes;
         m.dynamic_outside_dropped += dropped ? 1 : 0;
@@ -519,7 +531,7 @@ cv::Mat loadMask(const std::string& path) {
   cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (m.empty())
     throw Error(path + ": ground-truth mask missing or unreadable; expected an 8-bit PNG "
-                       "(0 static, 255 dynamic) of the image's size");
+                       "(0 static, 255 person, 128-254 other dynamic) of the image's size");
   return m;
 }
 

@@ -384,7 +384,9 @@ SynthFrame SequenceGenerator::frame(size_t i) const {
   renderer_->render(f.T_wc, all, ro);
   f.depth_exact = ro.depth;
   f.ids = ro.ids;
-  f.mask = ro.ids > 0;
+  f.mask = cv::Mat::zeros(ro.ids.size(), CV_8U);
+  f.mask.setTo(kMaskOtherObject, ro.ids > 0);
+  for (const Person& p : people_) f.mask.setTo(kMaskPerson, ro.ids == p.id);
 
   // Per-object truth from the id buffer.
   std::vector<int> ids;

@@ -442,3 +442,28 @@ TEST(Screener, NearDynamicRuleAndDepthOnlyDilation) {
   EXPECT_TRUE(l.dilation_depth_only);
   EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.clusterMinFraction: 0\n", "b.yaml")), Error);
 }
+
+TEST(Metrics, PersonRecallLeavesOtherMovingObjectsOut) {
+  features::FeatureFrame f;
+  f.width = 100;
+  f.height = 100;
+  cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(40, 0, 20, 100)).setTo(255);  // a person
+  mask(cv::Rect(60, 40, 20, 20)).setTo(200);  // the box they carry (yolo_slam_synth's value)
+  // Person: 45 dropped, 50 dropped; box: 65 kept, 75 kept; wall: 10.
+  for (float x : {45.f, 50.f, 65.f, 75.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
+  f.dynamic = {1, 1, 0, 0, 0};
+  detection::Boxes boxes(1);
+  boxes[0].rect = cv::Rect2f(38, 0, 44, 100);
+  ScreeningMetrics m = evaluateScreening(f, mask, boxes);
+  EXPECT_EQ(m.dynamic_total, 4);
+  EXPECT_EQ(m.person_total, 2);
+  EXPECT_EQ(m.person_dropped, 2);
+  EXPECT_DOUBLE_EQ(m.dynamicRecall(), 0.5);
+  EXPECT_DOUBLE_EQ(m.personRecall(), 1.0);
+  EXPECT_EQ(m.static_total, 1);
+  ScreeningMetrics sum = m;
+  sum += m;
+  EXPECT_EQ(sum.person_total, 4);
+  EXPECT_NE(m.toJson().find("\"person_recall\":1"), std::string::npos) << m.toJson();
+}

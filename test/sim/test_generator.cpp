@@ -175,18 +175,21 @@ TEST(SimGenerator, BoxesEncloseMaskPixelsOfTheirObject) {
     EXPECT_TRUE(cls == "person" || cls == "box") << line;
     EXPECT_GT(vis, 0.0);
     EXPECT_LE(vis, 1.0);
-    rows[stamp].push_back({id, x1, y1, x2, y2});
+    rows[stamp].push_back({id, x1, y1, x2, y2, cls == "person" ? 1.0 : 0.0});
   }
-  int people = 0;
+  int people = 0, carried = 0;
   for (size_t i = 0; i < gen.size(); ++i) {
     sim::SynthFrame f = gen.frame(i);
     char stamp[32];
     std::snprintf(stamp, sizeof stamp, "%.6f", f.rgb_stamp);
     cv::Mat mask = cv::imread(d + "/masks/" + stamp + ".png", cv::IMREAD_UNCHANGED);
     EXPECT_EQ(cv::countNonZero(mask != f.mask), 0);
-    EXPECT_EQ(cv::countNonZero((f.ids > 0) != (mask == 255)), 0);
+    EXPECT_EQ(cv::countNonZero((f.ids > 0) != (mask > 127)), 0);
     for (const auto& r : rows[stamp]) {
       cv::Mat m = f.ids == (int)r[0];
+      const uint8_t value = r[5] > 0 ? sim::kMaskPerson : sim::kMaskOtherObject;
+      EXPECT_EQ(cv::countNonZero(m & (mask != value)), 0) << "id " << r[0] << " has the wrong mask value";
+      carried += r[5] > 0 ? 0 : cv::countNonZero(m);
       cv::Rect b((int)r[1], (int)r[2], (int)(r[3] - r[1]), (int)(r[4] - r[2]));
       EXPECT_EQ(cv::countNonZero(m), cv::countNonZero(m(b))) << "id " << r[0] << " escapes its box";
       EXPECT_EQ(cv::boundingRect(m), b);
@@ -194,6 +197,7 @@ TEST(SimGenerator, BoxesEncloseMaskPixelsOfTheirObject) {
     }
   }
   EXPECT_GT(people, 0) << "walking_half should show someone in its first frames";
+  EXPECT_GT(carried, 0) << "walking_half's carried box should be in view in its first frames";
 }
 
 TEST(SimGenerator, DepthModelLikeAKinect) {

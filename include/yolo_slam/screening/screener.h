@@ -192,6 +192,8 @@ struct ScreeningMetrics {
   int dynamic_outside_boxes = 0;  // of dynamic_total, inside no box: only label propagation
                                   // (tracking, map points) can drop them
   int dynamic_outside_dropped = 0;  // of those, marked dynamic
+  int person_total = 0;           // of dynamic_total, on a person (mask value 255)
+  int person_dropped = 0;         // of those, marked dynamic
   int static_in_boxes = 0;        // keypoints off the mask inside at least one box
   int static_in_boxes_kept = 0;   // of those, left static
   int static_total = 0;           // keypoints off the mask anywhere
@@ -199,6 +201,9 @@ struct ScreeningMetrics {
 
   // dynamic_dropped / dynamic_total (1 when there is no dynamic keypoint).
   double dynamicRecall() const;
+  // person_dropped / person_total: the recall the issue defines ("keypoints on a person's
+  // mask"); equal to dynamicRecall() unless the mask also shows other moving objects.
+  double personRecall() const;
   // Recall over the dynamic keypoints inside at least one box (what screening decides).
   double dynamicRecallInBoxes() const;
   // static_in_boxes_kept / static_in_boxes (1 when there is no static keypoint in a box).
@@ -209,7 +214,9 @@ struct ScreeningMetrics {
 };
 
 // Compares a screened frame with a ground-truth mask (CV_8UC1, same size as the image,
-// > 127 = dynamic). Keypoint positions are frame.keypoints rounded to the nearest pixel.
+// > 127 = dynamic, 255 = a person; yolo_slam_synth writes 200 for other moving objects, the
+// real TUM mask has 255 only). Keypoint positions are frame.keypoints rounded to the nearest
+// pixel.
 // ignore_border_px > 0 leaves out keypoints closer than that to the mask's boundary (on either
 // side): hand-made or network masks are drawn loosely and depth is misregistered there, so
 // those keypoints are neither clearly dynamic nor clearly static. Synthetic masks are exact:
@@ -217,8 +224,8 @@ struct ScreeningMetrics {
 ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,
                                    const detection::Boxes& boxes, int ignore_border_px = 0);
 
-// Reads a ground-truth mask PNG (8-bit, 0 static / 255 dynamic; colour images are converted to
-// grey). Throws yolo_slam::Error naming the file if it is missing or unreadable.
+// Reads a ground-truth mask PNG (8-bit, 0 static / 255 person / 128-254 other dynamic; colour
+// images are converted to grey). Throws yolo_slam::Error naming the file if it is missing or unreadable.
 cv::Mat loadMask(const std::string& path);
 
 }  // namespace screening

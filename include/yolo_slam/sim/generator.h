@@ -37,6 +37,12 @@ struct SynthOptions {
   static SynthOptions load(const Config& cfg);
 };
 
+// Values of the dynamic mask (masks/*.png): every value > 127 is dynamic, as in other masks;
+// a person is told apart from another moving object (the carried box of walking_half), since
+// dynamic recall is defined over the people a person detector is asked to find.
+constexpr uint8_t kMaskPerson = 255;
+constexpr uint8_t kMaskOtherObject = 200;
+
 // Ground truth of one visible dynamic object in one frame.
 struct ObjectTruth {
   int id = 0;
@@ -54,7 +60,7 @@ struct SynthFrame {
   cv::Mat depth;        // CV_32F metres after the sensor model (as written, before 16-bit)
   cv::Mat depth_exact;  // CV_32F metres, exact geometry, 0 = nothing
   cv::Mat ids;          // CV_16U object id per pixel
-  cv::Mat mask;         // CV_8U 255 = dynamic
+  cv::Mat mask;         // CV_8U kMaskPerson, kMaskOtherObject (both dynamic) or 0 (static)
   std::vector<ObjectTruth> objects;
 };
 
