@@ -1,6 +1,7 @@
 // detection_bench: ms per 640x480 frame (median of N after a warm-up) for each shared model at
 // its native input size, with 1 and 2 threads. Usage: detection_bench [--frames N] [--json]
-// [MODEL...]; default models: the five in <shared>/models.
+// [MODEL...]; default models: the five in <shared>/models, then the default detector (main
+// model plus Detector.extraModels, as the pipeline runs it).
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/timing.h"
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,7 +37,8 @@ int main(int argc, char** argv) {
         models.push_back(a);
       }
     }
-    if (models.empty())
+    const bool default_models = models.empty();
+    if (default_models)
       for (const char* m : {"mnv2-yolov3-nano-voc", "mnv2-yolov3-nano-coco", "yolo-fastest-xl-voc",
                             "yolo-fastest-1.1-body", "nanodet-m/nanodet.onnx", "nanodet-m/nanodet_m.onnx"})
         models.push_back(joinPath(sharedDir(), std::string("models/") + m));
@@ -49,35 +52,47 @@ int main(int argc, char** argv) {
 
     if (json) std::cout << "[";
     bool first = true;
+    auto measure = [&](detection::Detector& det, const std::string& name, const std::string& input,
+                       int threads) {
+      for (int i = 0; i < 3; ++i) det.detect(frame);  // warm-up
+      std::vector<double> ms;
+      size_t boxes = 0;
+      for (int i = 0; i < frames; ++i) {
+        Stopwatch sw;
+        boxes = det.detect(frame).size();
+        ms.push_back(sw.ms());
+      }
+      Summary s = summarize(ms);
+      if (json) {
+        std::printf("%s{\"model\":\"%s\",\"input\":\"%s\",\"threads\":%d,\"frames\":%d,"
+                    "\"median_ms\":%.2f,\"p95_ms\":%.2f,\"boxes\":%zu}",
+                    first ? "" : ",\n ", name.c_str(), input.c_str(), threads, frames, s.median, s.p95,
+                    boxes);
+      } else {
+        std::printf("%-60s %s threads=%d median=%.2f ms p95=%.2f ms boxes=%zu\n", name.c_str(),
+                    input.c_str(), threads, s.median, s.p95, boxes);
+      }
+      std::fflush(stdout);
+      first = false;
+    };
     for (const auto& model : models) {
       for (int threads : {1, 2}) {
         detection::DetectorOptions opt;
         opt.model = model;
         opt.threads = threads;
-        // Single-class models name their class differently; keep whatever the model detects.
-        if (model.find("body") != std::string::npos) opt.dynamic_classes = {"body"};
+        opt.extra_models.clear();
         detection::YoloDetector det(opt);
-        for (int i = 0; i < 3; ++i) det.detect(frame);  // warm-up
-        std::vector<double> ms;
-        size_t boxes = 0;
-        for (int i = 0; i < frames; ++i) {
-          Stopwatch sw;
-          boxes = det.detect(frame).size();
-          ms.push_back(sw.ms());
-        }
-        Summary s = summarize(ms);
         const cv::Size in = det.inputSize();
-        if (json) {
-          std::printf("%s{\"model\":\"%s\",\"input\":\"%dx%d\",\"threads\":%d,\"frames\":%d,"
-                      "\"median_ms\":%.2f,\"p95_ms\":%.2f,\"boxes\":%zu}",
-                      first ? "" : ",\n ", model.c_str(), in.width, in.height, threads, frames,
-                      s.median, s.p95, boxes);
-        } else {
-          std::printf("%-60s %dx%d threads=%d median=%.2f ms p95=%.2f ms boxes=%zu\n", model.c_str(),
-                      in.width, in.height, threads, s.median, s.p95, boxes);
-        }
-        std::fflush(stdout);
-        first = false;
+        measure(det, model, std::to_string(in.width) + "x" + std::to_string(in.height), threads);
+      }
+    }
+    if (default_models) {
+      // What the pipeline runs by default: the main model plus Detector.extraModels, merged.
+      for (int threads : {1, 2}) {
+        detection::DetectorOptions opt;
+        opt.threads = threads;
+        std::unique_ptr<detection::Detector> det = detection::makeDetector(opt);
+        measure(*det, "default detector (main + extra models)", "native", threads);
       }
     }
     if (json) std::cout << "]\n";

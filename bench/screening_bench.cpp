@@ -84,8 +84,7 @@ RealFrame loadRealFrame(bool use_detector) {
   features::OrbExtractor orb{features::OrbOptions{}};
   rf.frame = features::buildFeatureFrame(orb, cam, bgr, depth_m, 1341846313.592026);
   if (use_detector) {
-    detection::YoloDetector det{detection::DetectorOptions{}};
-    rf.boxes = det.detect(bgr);
+    rf.boxes = detection::makeDetector(detection::DetectorOptions{})->detect(bgr);
   } else {
     rf.boxes = boxesFromMask(rf.mask);
   }
