@@ -154,7 +154,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
           features::buildFeatureFrame(*orb_, cam, image, depth_m, rgb->header.stamp.toSec());
       detection::Boxes boxes;
       if (boxes_msg) boxes = boxesFromMsg(boxes_msg->boxes);
-      boxes = screening_->process(frame, boxes, cam).boxes;  // + boxes carried by the tracker
+      boxes = screening_->process(frame, boxes, cam, depth_m).boxes;  // + boxes carried by the tracker
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;

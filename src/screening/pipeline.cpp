@@ -13,10 +13,10 @@ ScreeningPipeline::ScreeningPipeline(const ScreeningOptions& options) : screener
 
 PipelineResult ScreeningPipeline::process(features::FeatureFrame& frame,
                                           const detection::Boxes& detections,
-                                          const CameraModel& cam) {
+                                          const CameraModel& cam, const cv::Mat& depth_m) {
   PipelineResult r;
   r.boxes = box_tracker_ ? box_tracker_->predict(frame, detections) : detections;
-  r.stats = screener_.screen(frame, r.boxes);
+  r.stats = screener_.screen(frame, r.boxes, depth_m);
   // The tracker remembers what screening found in its boxes, before propagation adds labels
   // that may lie outside them and the veto removes some.
   if (box_tracker_) box_tracker_->observe(frame);

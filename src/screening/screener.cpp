@@ -71,6 +71,8 @@ void ScreeningOptions::validate(const std::string& where) const {
     bad("clusterMinFraction must be in (0, 1], got " + std::to_string(cluster_min_fraction));
   if (!(no_depth_radius_px > 0) || !std::isfinite(no_depth_radius_px))
     bad("noDepthRadius must be > 0 (pixels), got " + std::to_string(no_depth_radius_px));
+  if (!(silhouette_radius_px >= 0) || !std::isfinite(silhouette_radius_px))
+    bad("silhouetteRadius must be >= 0 (pixels; 0 = off), got " + std::to_string(silhouette_radius_px));
   if (!(flat_box_fraction > 0 && flat_box_fraction <= 1))
     bad("flatBoxFraction must be in (0, 1], got " + std::to_string(flat_box_fraction));
   if (!(flat_box_tolerance > 0) || !std::isfinite(flat_box_tolerance))
@@ -124,6 +126,7 @@ ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   o.grow_depth_m = cfg.getDouble("Screening.growDepth", o.grow_depth_m);
   o.cluster_min_fraction = cfg.getDouble("Screening.clusterMinFraction", o.cluster_min_fraction);
   o.no_depth_radius_px = cfg.getDouble("Screening.noDepthRadius", o.no_depth_radius_px);
+  o.silhouette_radius_px = cfg.getDouble("Screening.silhouetteRadius", o.silhouette_radius_px);
   o.dilation_depth_only = cfg.getBool("Screening.dilationDepthOnly", o.dilation_depth_only);
   o.reject_flat_boxes = cfg.getBool("Screening.rejectFlatBoxes", o.reject_flat_boxes);
   o.flat_box_fraction = cfg.getDouble("Screening.flatBoxFraction", o.flat_box_fraction);
@@ -280,8 +283,8 @@ bool inside(const cv::Rect2f& r, const cv::Point2f& p) {
   return p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height;
 }
 
-ScreeningStats Screener::screen(features::FeatureFrame& frame,
-                                const detection::Boxes& boxes) const {
+ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                                const cv::Mat& depth_m) const {
   Stopwatch sw;
   ScreeningStats st;
   const size_t n = frame.keypoints.size();
@@ -300,6 +303,45 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
   std::vector<float> depths;
   members.reserve(n);
   depths.reserve(n);
+
+  // Silhouette rule: keypoints of the region left static whose depth is missing or outside the
+  // person's range [lo, hi] (+- grow_depth_m), with a depth pixel inside it within the radius.
+  const bool silhouette = opt_.silhouette_radius_px > 0 && !depth_m.empty();
+  if (silhouette && (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height))
+    throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of the "
+                "frame's size (" + std::to_string(frame.width) + "x" + std::to_string(frame.height) + ")");
+  auto markSilhouette = [&](const std::vector<int>& idx, const std::vector<float>& dep,
+                            const std::vector<uint8_t>& mem, const cv::Rect2f& box) {
+    float lo = std::numeric_limits<float>::max(), hi = 0.f;
+    for (size_t m = 0; m < mem.size(); ++m)
+      if (mem[m]) lo = std::min(lo, dep[m]), hi = std::max(hi, dep[m]);
+    if (hi <= 0.f) return;
+    lo -= static_cast<float>(opt_.grow_depth_m);
+    hi += static_cast<float>(opt_.grow_depth_m);
+    const cv::Rect img(0, 0, depth_m.cols, depth_m.rows);
+    for (int i : idx) {
+      if (drop[i] || !inside(box, frame.keypoints[i].pt)) continue;
+      const float d = frame.depth[i];
+      if (d >= lo && d <= hi) continue;  // at the person's depth: Algorithm 1's call stands
+      const cv::KeyPoint& kp = frame.keypoints[i];
+      const int r = std::max(1, static_cast<int>(std::lround(opt_.silhouette_radius_px * kp.size / 31.f)));
+      const cv::Rect win = cv::Rect(static_cast<int>(std::lround(kp.pt.x)) - r,
+                                    static_cast<int>(std::lround(kp.pt.y)) - r, 2 * r + 1, 2 * r + 1) & img;
+      bool near_person = false;
+      for (int v = win.y; v < win.br().y && !near_person; ++v) {
+        const float* row = depth_m.ptr<float>(v);
+        for (int u = win.x; u < win.br().x; ++u)
+          if (row[u] >= lo && row[u] <= hi) {
+            near_person = true;
+            break;
+          }
+      }
+      if (near_person) {
+        drop[i] = 1;
+        ++st.silhouette;
+      }
+    }
+  };
 
   // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + 7919 r so regions
   // are independent of each other and of previous frames.
@@ -347,6 +389,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame,
     }
     for (size_t m = 0; m < member.size(); ++m)
       if (member[m]) drop[members[m]] = 1;
+    if (region_box && silhouette) markSilhouette(idx, depths, member, *region_box);
     if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
     const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
     const float nd2 = static_cast<float>(opt_.no_depth_radius_px * opt_.no_depth_radius_px);

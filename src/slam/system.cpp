@@ -118,7 +118,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   screening::PipelineResult screened;
   {
     std::lock_guard<std::mutex> lk(screening_mutex_);
-    screened = screening_->process(ff, boxes, cam_);
+    screened = screening_->process(ff, boxes, cam_, depth);
   }
   const screening::ScreeningStats& ss = screened.stats;
   detection::Boxes& used = screened.boxes;
@@ -132,6 +132,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     stats_.keypoints_in_boxes += ss.in_boxes;
     stats_.keypoints_kept += ss.kept;
     stats_.keypoints_dropped += ss.dropped;
+    stats_.keypoints_silhouette += ss.silhouette;
     stats_.keypoints_propagated += screened.temporal.propagated;
     stats_.keypoints_vetoed += screened.temporal.vetoed;
     stats_.boxes_vetoed += screened.temporal.boxes_vetoed;
@@ -331,7 +332,8 @@ std::string statsCountsJson(const SystemStats& s) {
     << ",\n  \"relocalizations\": " << s.relocalizations << ",\n  \"loops_closed\": " << s.loops_closed
     << ",\n  \"global_bundle_adjustments\": " << s.global_bas
     << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-    << ", \"dropped\": " << s.keypoints_dropped << ", \"propagated\": " << s.keypoints_propagated
+    << ", \"dropped\": " << s.keypoints_dropped << ", \"silhouette\": " << s.keypoints_silhouette
+    << ", \"propagated\": " << s.keypoints_propagated
     << ", \"vetoed\": " << s.keypoints_vetoed << "}"
     << ",\n  \"temporal\": {\"matched\": " << s.temporal_matched
     << ", \"static_consistent\": " << s.temporal_static_consistent

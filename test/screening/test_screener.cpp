@@ -467,3 +467,54 @@ TEST(Metrics, PersonRecallLeavesOtherMovingObjectsOut) {
   EXPECT_EQ(sum.person_total, 4);
   EXPECT_NE(m.toJson().find("\"person_recall\":1"), std::string::npos) << m.toJson();
 }
+
+TEST(Screener, SilhouetteRuleDropsKeypointsOnThePersonsOutline) {
+  // Depth image of makeScene's layout: wall at 4 m, the person (x 150-249) at 1.5 m, and a
+  // 3 px band without depth on the person's right outline (x 250-252), as a Kinect loses it.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(4.f));
+  depth(cv::Rect(150, 0, 100, 480)).setTo(1.5f);
+  depth(cv::Rect(250, 0, 3, 480)).setTo(0.f);
+  auto scene = [] {
+    Scene s = makeScene();
+    auto add = [&](cv::Point2f p, float d, float size) {
+      s.frame.keypoints.emplace_back(p, size);
+      s.frame.depth.push_back(d);
+      s.person.push_back(false);
+    };
+    add({251, 200}, 0.f, 31.f);       // in the hole band: no depth of its own
+    add({251, 300}, 4.f, 31.f);       // on the outline, its depth pixel read the wall
+    add({253, 400}, 4.f, 31.f * 1.2f * 1.2f * 1.2f * 1.2f);  // level 4: radius 2 x 2.07 = 4 px
+    add({253, 100}, 4.f, 31.f);       // same place at level 0: 2 px reach only the hole band
+    add({120, 200}, 4.f, 31.f);       // wall inside the box, far from the person
+    s.frame.keypoints_un = s.frame.keypoints;
+    return s;
+  };
+  ScreeningOptions o;
+  o.no_depth = ScreeningOptions::NoDepthRule::Static;  // the no-depth rule must not interfere
+  ASSERT_EQ(o.silhouette_radius_px, 2.0);
+  Scene s = scene();
+  const size_t n = s.frame.size();
+  ScreeningStats st = Screener(o).screen(s.frame, s.boxes, depth);
+  EXPECT_EQ(s.frame.dynamic[n - 5], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 4], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 3], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 2], 0);
+  EXPECT_EQ(s.frame.dynamic[n - 1], 0);
+  EXPECT_EQ(st.silhouette, 3);
+
+  // Without the depth image, or with the radius 0, the rule is off.
+  Scene s2 = scene();
+  EXPECT_EQ(Screener(o).screen(s2.frame, s2.boxes).silhouette, 0);
+  EXPECT_EQ(s2.frame.dynamic[n - 4], 0);
+  o.silhouette_radius_px = 0;
+  Scene s3 = scene();
+  EXPECT_EQ(Screener(o).screen(s3.frame, s3.boxes, depth).silhouette, 0);
+  EXPECT_EQ(s3.frame.dynamic[n - 4], 0);
+
+  // A depth image of another size is an error naming the rule.
+  o.silhouette_radius_px = 2;
+  Scene s4 = scene();
+  EXPECT_THROW(Screener(o).screen(s4.frame, s4.boxes, cv::Mat(240, 320, CV_32F, cv::Scalar(1.f))), Error);
+  EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.silhouetteRadius: -1\n", "s.yaml")), Error);
+  EXPECT_EQ(ScreeningOptions::load(Config::fromString("Screening.silhouetteRadius: 5\n", "s.yaml")).silhouette_radius_px, 5.0);
+}

@@ -31,9 +31,10 @@ class ScreeningPipeline {
   const Screener& screener() const { return screener_; }
 
   // Screens `frame` (sets frame.dynamic) with the detector's boxes of this frame; `cam` gives
-  // the intrinsics for label propagation's camera-motion estimate.
+  // the intrinsics for label propagation's camera-motion estimate; depth_m (CV_32F metres, may
+  // be empty) the depth image for the silhouette rule.
   PipelineResult process(features::FeatureFrame& frame, const detection::Boxes& detections,
-                         const CameraModel& cam);
+                         const CameraModel& cam, const cv::Mat& depth_m = cv::Mat());
   // Forgets tracked boxes and the previous frame (a new sequence or a map reset).
   void clear();
 

@@ -73,6 +73,12 @@ struct ScreeningOptions {
   // of the keypoints of the box's largest cluster.
   double cluster_min_fraction = 0.3;
   double no_depth_radius_px = 40;  // NearDynamic rule: radius in pixels
+  // Silhouette rule (beyond the paper; box modes, needs the depth image passed to screen()): a
+  // keypoint left static in a box whose own depth is missing or off the person's depth range,
+  // but which has a depth pixel inside that range within this radius (pixels at pyramid level
+  // 0, times the keypoint's scale), sits on the person's outline: its patch straddles the
+  // moving person, and the depth sensor loses or smears the outline. 0 turns it off.
+  double silhouette_radius_px = 2;
   // When true, the dilation ring around a box (box_dilation) only takes keypoints whose depth
   // joins the person's set; the no-depth rule applies inside the detected box only.
   bool dilation_depth_only = false;
@@ -138,6 +144,7 @@ struct ScreeningStats {
   int iterations = 0;  // RANSAC iterations summed over boxes
   double ms = 0;       // wall time of screen()
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
+  int silhouette = 0;  // of dropped, keypoints the silhouette rule dropped
 };
 
 // The box grown by fraction f of its width/height on each side (Screening.boxDilation).
@@ -165,7 +172,10 @@ class Screener {
   // Box membership uses frame.keypoints (image pixel coordinates, like the boxes). Boxes are
   // all treated as dynamic-class boxes: the detector filters classes. Each call reseeds the
   // RNG from options().seed, so the result depends only on the frame and the boxes.
-  ScreeningStats screen(features::FeatureFrame& frame, const detection::Boxes& boxes) const;
+  // depth_m: the frame's depth image in metres (CV_32F, image size) for the silhouette rule;
+  // empty leaves that rule out.
+  ScreeningStats screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                        const cv::Mat& depth_m = cv::Mat()) const;
 
   // Algorithm 1 on a set of valid depths (metres, all > 0) with the given RNG seed (the paper
   // variant; the grow step needs pixel positions and runs in screen()).

@@ -49,6 +49,7 @@ struct SystemStats {
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
   long keypoints_propagated = 0;  // marked dynamic by label propagation (propagateLabels)
+  long keypoints_silhouette = 0;  // of keypoints_dropped, by the silhouette rule (silhouetteRadius)
   long keypoints_vetoed = 0;      // screened dynamic, kept by the static-box veto (staticBoxVeto)
   long boxes_vetoed = 0;          // boxes the static-box veto left alone
   // Frame-to-frame evidence (propagateLabels or staticBoxVeto): keypoints matched to the
