@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <random>
+#include <utility>
 
 using namespace yolo_slam;
 using namespace yolo_slam::screening;
@@ -45,6 +47,22 @@ Scene makeScene(unsigned seed = 1, int n_person = 120, int n_wall_in_box = 60, i
   b.rect = cv::Rect2f(100, 50, 200, 420);
   s.boxes.push_back(b);
   return s;
+}
+
+// A 100x100 frame with keypoints on the row y = 50 at `xs`, screened as `dynamic` says.
+features::FeatureFrame rowFrame(std::initializer_list<float> xs, std::vector<uint8_t> dynamic) {
+  features::FeatureFrame f;
+  f.width = 100;
+  f.height = 100;
+  for (float x : xs) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
+  f.dynamic = std::move(dynamic);
+  return f;
+}
+
+detection::Boxes oneBox(const cv::Rect2f& r) {
+  detection::Boxes boxes(1);
+  boxes[0].rect = r;
+  return boxes;
 }
 
 }  // namespace
@@ -313,15 +331,10 @@ TEST(Screener, NearestNoDepthRuleCopiesTheNeighbour) {
 }
 
 TEST(Metrics, IgnoredBorderBand) {
-  features::FeatureFrame f;
-  f.width = 100;
-  f.height = 100;
   cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
   mask(cv::Rect(40, 0, 20, 100)).setTo(255);
-  for (float x : {50.f, 41.f, 58.f, 37.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
-  f.dynamic = {1, 0, 0, 1, 0};
-  detection::Boxes boxes(1);
-  boxes[0].rect = cv::Rect2f(0, 0, 100, 100);
+  const features::FeatureFrame f = rowFrame({50.f, 41.f, 58.f, 37.f, 10.f}, {1, 0, 0, 1, 0});
+  const detection::Boxes boxes = oneBox(cv::Rect2f(0, 0, 100, 100));
   ScreeningMetrics all = evaluateScreening(f, mask, boxes);
   EXPECT_EQ(all.dynamic_total, 3);
   EXPECT_EQ(all.dynamic_dropped, 1);
@@ -336,16 +349,11 @@ TEST(Metrics, IgnoredBorderBand) {
 }
 
 TEST(Metrics, DynamicKeypointsOutsideEveryBoxAreCountedApart) {
-  features::FeatureFrame f;
-  f.width = 100;
-  f.height = 100;
   cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
   mask(cv::Rect(40, 0, 40, 100)).setTo(255);  // a person from x = 40 to 79
   // On the mask: 45 and 50 inside the box (one dropped), 70 and 75 outside it (one dropped).
-  for (float x : {45.f, 50.f, 70.f, 75.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
-  f.dynamic = {1, 0, 1, 0, 0};
-  detection::Boxes boxes(1);
-  boxes[0].rect = cv::Rect2f(40, 0, 20, 100);  // the box clips the person's right half
+  const features::FeatureFrame f = rowFrame({45.f, 50.f, 70.f, 75.f, 10.f}, {1, 0, 1, 0, 0});
+  const detection::Boxes boxes = oneBox(cv::Rect2f(40, 0, 20, 100));  // clips the person's right half
   ScreeningMetrics m = evaluateScreening(f, mask, boxes);
   EXPECT_EQ(m.dynamic_total, 4);
   EXPECT_EQ(m.dynamic_dropped, 2);
@@ -444,17 +452,12 @@ TEST(Screener, NearDynamicRuleAndDepthOnlyDilation) {
 }
 
 TEST(Metrics, PersonRecallLeavesOtherMovingObjectsOut) {
-  features::FeatureFrame f;
-  f.width = 100;
-  f.height = 100;
   cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
   mask(cv::Rect(40, 0, 20, 100)).setTo(255);  // a person
   mask(cv::Rect(60, 40, 20, 20)).setTo(200);  // the box they carry (yolo_slam_synth's value)
   // Person: 45 dropped, 50 dropped; box: 65 kept, 75 kept; wall: 10.
-  for (float x : {45.f, 50.f, 65.f, 75.f, 10.f}) f.keypoints.emplace_back(cv::Point2f(x, 50), 31.f);
-  f.dynamic = {1, 1, 0, 0, 0};
-  detection::Boxes boxes(1);
-  boxes[0].rect = cv::Rect2f(38, 0, 44, 100);
+  const features::FeatureFrame f = rowFrame({45.f, 50.f, 65.f, 75.f, 10.f}, {1, 1, 0, 0, 0});
+  const detection::Boxes boxes = oneBox(cv::Rect2f(38, 0, 44, 100));
   ScreeningMetrics m = evaluateScreening(f, mask, boxes);
   EXPECT_EQ(m.dynamic_total, 4);
   EXPECT_EQ(m.person_total, 2);
