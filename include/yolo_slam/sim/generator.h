@@ -64,10 +64,17 @@ struct SynthFrame {
   std::vector<ObjectTruth> objects;
 };
 
+// A walker's beat: it walks from (ax, ay) to (bx, by) on the floor and back (metres, room frame;
+// the camera starts at the origin looking along +y).
+struct FloorSegment {
+  double ax, ay, bx, by;
+};
+
 struct PresetInfo {
   std::string name, motion, description;
   int frames, walkers, sitters;
   bool carried_box;
+  std::vector<FloorSegment> walker_paths;  // walker k takes path k modulo the count
 };
 const std::vector<PresetInfo>& presets();
 
