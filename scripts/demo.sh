@@ -21,6 +21,9 @@ while [ $# -gt 0 ]; do
 done
 
 bash "$YS_ROOT/scripts/install_deps.sh"
+# A fresh clone has no build/ (git-ignored): create it before logging into it.
+mkdir -p "$YS_ROOT/build"
+echo "== building (log: build/demo_build.log)"
 bash "$YS_ROOT/scripts/build.sh" > "$YS_ROOT/build/demo_build.log" 2>&1 || {
   tail -30 "$YS_ROOT/build/demo_build.log"; echo "demo.sh: build failed (log: build/demo_build.log)"; exit 1; }
 

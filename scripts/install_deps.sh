@@ -1,22 +1,57 @@
 #!/usr/bin/env bash
-# Installs every Debian package yolo_slam needs to build, test and run its demo.
-# Idempotent: packages already present are skipped by apt; nothing comes from outside Debian.
+# Installs every Debian package yolo_slam needs to build, test and run its demo: the one list
+# of the project's Debian packages. Each "key:" row below is a dependency key of package.xml
+# with the Debian packages that provide it (test/common/test_package_manifest.cpp checks that the two
+# match); the rows without a key are build tools and data the package.xml has no key for.
+# Idempotent: packages already present are skipped; nothing comes from outside Debian.
 set -euo pipefail
 
-PACKAGES=(
-  # build tools and the ROS 1 stack as Debian 12 ships it (see docs in ../shared/docs/ros-on-debian.md)
-  build-essential cmake pkg-config git
-  ros-base-dev libtf2-ros-dev libcv-bridge-dev libimage-transport-dev python3-rostest rosbash
-  tf2-tools tf-tools libtf-dev rviz libdiagnostic-msgs-dev libros-rosgraph-msgs-dev
-  libopencv-dev libeigen3-dev libceres-dev libopenni2-dev libgtest-dev
-  python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-geometry-msgs
-  python3-std-srvs python3-rosbag python3-tf2-ros
-  xvfb x11-apps imagemagick python3-numpy python3-scipy python3-matplotlib python3-yaml
-  python3-opencv
-  # real images and video: textures and people for the simulator, vocabulary training data,
-  # reference Darknet cfgs and the darknet trainer
-  opencv-doc darknet
-)
+DEPENDENCIES='
+  build tools:        build-essential cmake pkg-config git
+  catkin:             catkin ros-base-dev
+  roscpp:             libroscpp-dev
+  nodelet:            libnodelet-dev
+  pluginlib:          pluginlib-dev
+  std_msgs:           libstd-msgs-dev
+  std_srvs:           libstd-srvs-dev python3-std-srvs
+  sensor_msgs:        libsensor-msgs-dev python3-sensor-msgs
+  geometry_msgs:      libgeometry-msgs-dev python3-geometry-msgs
+  nav_msgs:           libnav-msgs-dev python3-nav-msgs
+  visualization_msgs: libvisualization-msgs-dev python3-visualization-msgs
+  diagnostic_msgs:    libdiagnostic-msgs-dev python3-diagnostic-msgs
+  tf2_ros:            libtf2-ros-dev python3-tf2-ros
+  message_filters:    libmessage-filters-dev
+  libopencv-dev:      libopencv-dev
+  eigen:              libeigen3-dev
+  libceres-dev:       libceres-dev
+  libopenni2-dev:     libopenni2-dev
+  message_generation: ros-message-generation
+  message_runtime:    ros-message-runtime
+  roslaunch:          python3-roslaunch rosbash
+  rosbag:             python3-rosbag
+  rviz:               rviz
+  rospy:              python3-rospy
+  tf2_msgs:           python3-tf2-msgs
+  python3-opencv:     python3-opencv
+  python3-numpy:      python3-numpy
+  rostest:            python3-rostest
+  rosgraph_msgs:      libros-rosgraph-msgs-dev
+  gtest:              libgtest-dev
+  data:               opencv-doc darknet
+'
+# data: real images and video (textures and people for the simulator, vocabulary training
+# data), reference Darknet cfgs and the darknet trainer.
+
+if [ "${1:-}" = "--list" ]; then
+  echo "$DEPENDENCIES"
+  exit 0
+fi
+
+PACKAGES=()
+while IFS= read -r row; do
+  [ -n "${row// /}" ] || continue
+  for p in ${row#*:}; do PACKAGES+=("$p"); done
+done <<< "$DEPENDENCIES"
 
 missing=()
 for p in "${PACKAGES[@]}"; do
