@@ -129,14 +129,13 @@ int run(int argc, char** argv) {
 
   std::unique_ptr<detection::Detector> detector = detection::makeDetector(opt);
   if (!json) std::cout << "# model: " << detector->description() << "\n";
-  if (json) std::cout << "[";
+  Json results = Json::array();
   for (size_t i = 0; i < images.size(); ++i) {
     cv::Mat img = cv::imread(images[i], cv::IMREAD_COLOR);
     if (img.empty()) throw Error("cannot read image " + images[i] + "; check the path and format");
     detection::Boxes boxes = detector->detect(img);
     if (json) {
-      std::cout << (i ? ",\n " : "") << "{\"image\":\"" << jsonEscape(images[i])
-                << "\",\"boxes\":" << detection::boxesJson(boxes) << "}";
+      results.push_back({{"image", images[i]}, {"boxes", detection::boxesJson(boxes)}});
     } else {
       std::cout << images[i] << ": " << boxes.size() << " box(es)\n";
       for (const auto& b : boxes) {
@@ -161,7 +160,7 @@ int run(int argc, char** argv) {
       if (!ok) throw Error("cannot write " + out + "; check the folder exists and the name ends in .png");
     }
   }
-  if (json) std::cout << "]\n";
+  if (json) std::cout << results.dump() << "\n";
   return 0;
 }
 

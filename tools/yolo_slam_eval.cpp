@@ -70,6 +70,15 @@ std::string f6(double v) {
   return buf;
 }
 
+// {"pairs", prefix + "rmse" + suffix, ... mean, median, std, min, max}
+Json errorStatsJson(const eval::ErrorStats& s, const std::string& prefix, const std::string& suffix = "") {
+  Json j{{"pairs", s.count}};
+  const std::pair<const char*, double> fields[] = {{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
+                                                   {"std", s.std},   {"min", s.min},   {"max", s.max}};
+  for (const auto& f : fields) j[prefix + f.first + suffix] = jsonNumber(f.second);
+  return j;
+}
+
 int runAte(const std::string& gt_path, const std::string& est_path, double max_diff,
            const std::string& plot, bool json) {
   const Trajectory gt = load(gt_path, "ground-truth");
@@ -90,10 +99,7 @@ int runAte(const std::string& gt_path, const std::string& est_path, double max_d
   const eval::ErrorStats& s = r.stats;
   std::ostringstream out;
   if (json) {
-    out << "{\"pairs\":" << s.count << ",\"rmse\":" << jsonNumber(s.rmse, 9)
-        << ",\"mean\":" << jsonNumber(s.mean, 9) << ",\"median\":" << jsonNumber(s.median, 9)
-        << ",\"std\":" << jsonNumber(s.std, 9) << ",\"min\":" << jsonNumber(s.min, 9)
-        << ",\"max\":" << jsonNumber(s.max, 9) << "}\n";
+    out << dumpJson(errorStatsJson(s, ""));
   } else {
     // Same names as evaluate_ate.py --verbose.
     const Eigen::Matrix3d R = r.alignment.linear();
@@ -131,15 +137,14 @@ int runRpe(const std::string& gt_path, const std::string& est_path, const eval::
   const eval::ErrorStats& a = r.rot_deg;
   std::ostringstream out;
   if (json) {
-    out << "{\"pairs\":" << t.count << ",\"trans_rmse\":" << jsonNumber(t.rmse, 9)
-        << ",\"trans_mean\":" << jsonNumber(t.mean, 9) << ",\"trans_median\":" << jsonNumber(t.median, 9)
-        << ",\"trans_std\":" << jsonNumber(t.std, 9) << ",\"trans_min\":" << jsonNumber(t.min, 9)
-        << ",\"trans_max\":" << jsonNumber(t.max, 9) << ",\"rot_rmse_deg\":" << jsonNumber(a.rmse, 9)
-        << ",\"rot_mean_deg\":" << jsonNumber(a.mean, 9) << ",\"rot_median_deg\":" << jsonNumber(a.median, 9)
-        << ",\"rot_std_deg\":" << jsonNumber(a.std, 9) << ",\"rot_min_deg\":" << jsonNumber(a.min, 9)
-        << ",\"rot_max_deg\":" << jsonNumber(a.max, 9) << ",\"delta\":" << jsonNumber(opt.delta, 9)
-        << ",\"delta_unit\":\"" << eval::toString(opt.unit) << "\""
-        << ",\"max_diff\":" << jsonNumber(r.max_time_diff, 9) << "}\n";
+    Json j = errorStatsJson(t, "trans_");
+    const Json rot = errorStatsJson(a, "rot_", "_deg");
+    for (const auto& kv : rot.items())
+      if (kv.key() != "pairs") j[kv.key()] = kv.value();
+    j["delta"] = jsonNumber(opt.delta);
+    j["delta_unit"] = eval::toString(opt.unit);
+    j["max_diff"] = jsonNumber(r.max_time_diff);
+    out << dumpJson(j);
   } else {
     char delta[32];
     std::snprintf(delta, sizeof(delta), "%g", opt.delta);

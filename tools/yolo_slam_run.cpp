@@ -53,7 +53,7 @@ const char* kUsage =
     "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
-    "                     [--static-box-veto on|off]\n"
+    "                     [--static-box-veto on|off] [--set KEY=VALUE ...]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -70,8 +70,11 @@ const char* kUsage =
     "                     LocalMapping.*, Detector.*); default DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
-    "  --dynamic-mode M   override Screening.mode of the config: off, detect, geometry or\n"
-    "                     detect+geometry (the paper's method)\n"
+    "  --set KEY=VALUE    override a settings key (repeatable; YAML value: a number, a word or\n"
+    "                     [a, b]), e.g. --set Screening.boxDilation=0.1; the effective settings\n"
+    "                     are written to stats.json (\"settings\")\n"
+    "  --dynamic-mode M   --set Screening.mode=M: off, detect, geometry or detect+geometry\n"
+    "                     (the paper's method)\n"
     "  --model DIR        main detector model (folder, .cfg or .onnx); default Detector.model\n"
     "                     (Detector.extraModels still run beside it)\n"
     "  --single-model     run the main model alone (Detector.extraModels: \"\")\n"
@@ -79,74 +82,43 @@ const char* kUsage =
     "                     package's vocab/yolo_slam_orb_k10_L4.vocab when it exists\n"
     "  --no-vocabulary    run without BoW: no BoW matching, relocalisation or loop closing\n"
     "  --boxes-from-gt    person boxes from the sequence's boxes.txt (synthetic ground truth)\n"
-    "                     instead of running the detector\n"    "  --boxes FILE       replay the detector's boxes of an earlier run (its OUT/boxes_screened.txt,\n"
+    "                     instead of running the detector\n"
+    "  --boxes FILE       replay the detector's boxes of an earlier run (its OUT/boxes_screened.txt,\n"
     "                     with their scores) instead of running the detector\n"
-    "  --track-boxes B    override Screening.trackBoxes: on carries person boxes over frames\n"
+    "  --track-boxes B    --set Screening.trackBoxes (on/off): on carries person boxes over frames\n"
     "                     where the detector misses them (modes detect, detect+geometry);\n"
     "                     screening metrics count the boxes actually screened\n"
-    "  --propagate-labels B  override Screening.propagateLabels: on marks keypoints matching a\n"
+    "  --propagate-labels B  --set Screening.propagateLabels (on/off): on marks keypoints matching a\n"
     "                     moving dynamic keypoint of the previous frame dynamic (every mode\n"
     "                     but off)\n"
-    "  --static-box-veto B  override Screening.staticBoxVeto: on keeps the keypoints of a box\n"
+    "  --static-box-veto B  --set Screening.staticBoxVeto (on/off): on keeps the keypoints of a box\n"
     "                     whose dropped keypoints all sit where static points would be\n"
     "  -h, --help         this text\n";
 
 struct Args {
-  std::string sequence, config, out, model, vocabulary, dynamic_mode, track_boxes,
-      propagate_labels, static_box_veto, boxes_file;
+  std::string sequence, config, out, model, vocabulary, boxes_file;
+  // Settings overrides in command-line order (--set and the flags that stand for a key).
+  std::vector<std::string> overrides;
   long max_frames = -1;
   bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
        single_model = false;
 };
 
-Args parseArgs(int argc, char** argv) {
-  Args a;
-  auto need = [&](int& i, const std::string& flag) -> std::string {
-    if (i + 1 >= argc) throw Error("missing value after " + flag + "\n" + kUsage);
-    return argv[++i];
-  };
-  for (int i = 1; i < argc; ++i) {
-    std::string s = argv[i];
-    if (s == "--sequence") a.sequence = need(i, s);
-    else if (s == "--config") a.config = need(i, s);
-    else if (s == "--out") a.out = need(i, s);
-    else if (s == "--model") a.model = need(i, s);
-    else if (s == "--single-model") a.single_model = true;
-    else if (s == "--vocabulary") a.vocabulary = need(i, s), a.vocabulary_given = true;
-    else if (s == "--no-vocabulary") a.no_vocabulary = true;
-    else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
-    else if (s == "--realtime") a.realtime = true;
-    else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
-    else if (s == "--boxes") a.boxes_file = need(i, s);
-    else if (s == "--propagate-labels") {
-      a.propagate_labels = need(i, s);
-      if (a.propagate_labels != "on" && a.propagate_labels != "off")
-        throw Error("--propagate-labels must be on or off (got '" + a.propagate_labels + "')");
-    } else if (s == "--static-box-veto") {
-      a.static_box_veto = need(i, s);
-      if (a.static_box_veto != "on" && a.static_box_veto != "off")
-        throw Error("--static-box-veto must be on or off (got '" + a.static_box_veto + "')");
-    } else if (s == "--track-boxes") {
-      a.track_boxes = need(i, s);
-      if (a.track_boxes != "on" && a.track_boxes != "off")
-        throw Error("--track-boxes must be on or off (got '" + a.track_boxes + "')");
-    }
-    else if (s == "--max-frames") {
-      std::string v = need(i, s);
-      char* end = nullptr;
-      a.max_frames = std::strtol(v.c_str(), &end, 10);
-      if (!end || *end || a.max_frames <= 0) throw Error("--max-frames must be a positive integer (got '" + v + "')");
-    } else if (s == "-h" || s == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else {
-      throw Error("unknown option '" + s + "'; see --help");
-    }
-  }
-  if (a.sequence.empty() || a.out.empty())
-    throw Error(std::string("--sequence and --out are required\n") + kUsage);
-  if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
-  if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
+// "on"/"off" of a flag standing for a boolean key, as the key's override.
+std::string onOffOverride(const std::string& flag, const std::string& key, const std::string& v) {
+  if (v != "on" && v != "off") throw Error(flag + " must be on or off (got '" + v + "')");
+  return key + "=" + (v == "on" ? "1" : "0");
+}
+
+long positiveLong(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  const long n = std::strtol(v.c_str(), &end, 10);
+  if (!end || *end || n <= 0) throw Error(flag + " must be a positive integer (got '" + v + "')");
+  return n;
+}
+
+// Fills in the settings file and the vocabulary the user did not name.
+void resolveDefaultFiles(Args& a) {
   if (a.config.empty()) {
     // yolo_slam_synth writes camera.yaml beside the images; real TUM folders need --config.
     a.config = joinPath(a.sequence, "camera.yaml");
@@ -161,6 +133,44 @@ Args parseArgs(int argc, char** argv) {
     const std::string shipped = joinPath(packageDir(), kVocabName);
     if (fileExists(shipped)) a.vocabulary = shipped;
   }
+}
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  auto need = [&](int& i, const std::string& flag) -> std::string {
+    if (i + 1 >= argc) throw Error("missing value after " + flag + "\n" + kUsage);
+    return argv[++i];
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string s = argv[i];
+    if (s == "--sequence") a.sequence = need(i, s);
+    else if (s == "--config") a.config = need(i, s);
+    else if (s == "--out") a.out = need(i, s);
+    else if (s == "--model") a.model = need(i, s);
+    else if (s == "--single-model") a.single_model = true;
+    else if (s == "--vocabulary") a.vocabulary = need(i, s), a.vocabulary_given = true;
+    else if (s == "--no-vocabulary") a.no_vocabulary = true;
+    else if (s == "--set") a.overrides.push_back(need(i, s));
+    else if (s == "--dynamic-mode") a.overrides.push_back("Screening.mode=" + need(i, s));
+    else if (s == "--realtime") a.realtime = true;
+    else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
+    else if (s == "--boxes") a.boxes_file = need(i, s);
+    else if (s == "--propagate-labels") a.overrides.push_back(onOffOverride(s, "Screening.propagateLabels", need(i, s)));
+    else if (s == "--static-box-veto") a.overrides.push_back(onOffOverride(s, "Screening.staticBoxVeto", need(i, s)));
+    else if (s == "--track-boxes") a.overrides.push_back(onOffOverride(s, "Screening.trackBoxes", need(i, s)));
+    else if (s == "--max-frames") a.max_frames = positiveLong(s, need(i, s));
+    else if (s == "-h" || s == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else {
+      throw Error("unknown option '" + s + "'; see --help");
+    }
+  }
+  if (a.sequence.empty() || a.out.empty())
+    throw Error(std::string("--sequence and --out are required\n") + kUsage);
+  if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
+  if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
+  resolveDefaultFiles(a);
   return a;
 }
 
@@ -214,9 +224,6 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-// num/den as JSON; null without a denominator (e.g. no box in modes off/geometry).
-std::string jsonRatio(long num, long den) { return den > 0 ? jsonNumber(static_cast<double>(num) / den, 4) : "null"; }
-
 std::string percent(long num, long den) {
   if (den <= 0) return "n/a (none)";
   char buf[64];
@@ -229,24 +236,11 @@ struct MetricsAccumulator {
   screening::ScreeningMetrics sum;
   size_t frames = 0;
 
-  std::string json() const {
-    if (frames == 0) return "null";
-    std::ostringstream os;
-    os << "{\"frames\": " << frames << ", \"dynamic_keypoints\": " << sum.dynamic_total
-       << ", \"dropped\": " << sum.dynamic_dropped
-       << ", \"dynamic_recall\": " << jsonRatio(sum.dynamic_dropped, sum.dynamic_total)
-       << ", \"dynamic_outside_boxes\": " << sum.dynamic_outside_boxes
-       << ", \"dynamic_outside_dropped\": " << sum.dynamic_outside_dropped
-       << ", \"dynamic_recall_in_boxes\": "
-       << jsonRatio(sum.dynamic_dropped - sum.dynamic_outside_dropped,
-                    sum.dynamic_total - sum.dynamic_outside_boxes)
-       << ", \"person_keypoints\": " << sum.person_total << ", \"person_dropped\": " << sum.person_dropped
-       << ", \"person_recall\": " << jsonRatio(sum.person_dropped, sum.person_total)
-       << ", \"static_in_boxes\": " << sum.static_in_boxes << ", \"kept\": " << sum.static_in_boxes_kept
-       << ", \"static_retention\": " << jsonRatio(sum.static_in_boxes_kept, sum.static_in_boxes)
-       << ", \"static_keypoints\": " << sum.static_total << ", \"static_dropped\": " << sum.static_dropped
-       << ", \"static_drop_rate\": " << jsonRatio(sum.static_dropped, sum.static_total) << "}";
-    return os.str();
+  Json json() const {
+    if (frames == 0) return nullptr;
+    Json j{{"frames", frames}};
+    j.update(Json(sum));
+    return j;
   }
 };
 
@@ -263,116 +257,178 @@ void makeDirs(const std::string& dir) {
   if (!dirExists(dir)) throw Error(dir + ": cannot create the output folder; check the path and permissions");
 }
 
-int run(const Args& args) {
-  Config cfg = Config::fromFile(args.config);
-  CameraModel cam = CameraModel::load(cfg);
-  slam::SystemOptions sys_opt = slam::SystemOptions::load(cfg);
-  if (!args.dynamic_mode.empty()) sys_opt.screening.mode = screening::parseDynamicMode(args.dynamic_mode);
-  if (!args.track_boxes.empty()) sys_opt.screening.track_boxes = args.track_boxes == "on";
-  if (!args.propagate_labels.empty()) sys_opt.screening.propagate_labels = args.propagate_labels == "on";
-  if (!args.static_box_veto.empty()) sys_opt.screening.static_box_veto = args.static_box_veto == "on";
-  const screening::DynamicMode mode = sys_opt.screening.mode;
-  const bool needs_boxes = mode == screening::DynamicMode::Detect || mode == screening::DynamicMode::DetectGeometry;
-
-  io::TumSequence seq = io::TumSequence::open(args.sequence);
-  size_t n = seq.size();
-  if (args.max_frames > 0) n = std::min(n, static_cast<size_t>(args.max_frames));
-
-  std::map<long long, detection::Boxes> gt_boxes;
+// Everything a run reads before its first frame: settings (with the overrides applied before
+// anything loads), camera, sequence, where the boxes come from, vocabulary.
+struct RunSetup {
+  Config cfg;
+  CameraModel cam;
+  slam::SystemOptions options;
+  screening::Stages stages;
+  io::TumSequence seq;
+  size_t frames = 0;
+  std::map<long long, detection::Boxes> file_boxes;  // --boxes-from-gt / --boxes
   std::unique_ptr<detection::Detector> detector;
-  std::string detector_name = "none";
-  if (needs_boxes) {
-    if (args.boxes_from_gt) {
-      gt_boxes = readBoxFile(joinPath(args.sequence, "boxes.txt"), false);
-      detector_name = "ground-truth boxes.txt";
-    } else if (!args.boxes_file.empty()) {
-      gt_boxes = readBoxFile(args.boxes_file, true);
-      detector_name = args.boxes_file;
-    } else {
-      detection::DetectorOptions dopt = detection::DetectorOptions::load(cfg);
-      if (!args.model.empty()) dopt.model = args.model;
-      if (args.single_model) dopt.extra_models.clear();
-      detector = detection::makeDetector(dopt);
-      detector_name = dopt.model;
-      for (const auto& m : dopt.extra_models) detector_name += " + " + m;
-    }
-  }
+  std::string boxes_source = "none";
   std::shared_ptr<const vocabulary::Vocabulary> voc;
-  if (!args.vocabulary.empty()) voc = vocabulary::Vocabulary::load(args.vocabulary);
+  std::string mask_dir;  // synthetic sequences: per-frame masks, masks/<rgb file name>
+  bool has_masks = false;
+};
+
+void setUpBoxes(const Args& args, RunSetup& r) {
+  if (!r.stages.detection) return;
+  if (args.boxes_from_gt) {
+    r.file_boxes = readBoxFile(joinPath(args.sequence, "boxes.txt"), false);
+    r.boxes_source = "ground-truth boxes.txt";
+  } else if (!args.boxes_file.empty()) {
+    r.file_boxes = readBoxFile(args.boxes_file, true);
+    r.boxes_source = args.boxes_file;
+  } else {
+    detection::DetectorOptions dopt = detection::DetectorOptions::load(r.cfg);
+    if (!args.model.empty()) dopt.model = args.model;
+    if (args.single_model) dopt.extra_models.clear();
+    r.detector = detection::makeDetector(dopt);
+    r.boxes_source = dopt.model;
+    for (const auto& m : dopt.extra_models) r.boxes_source += " + " + m;
+  }
+}
+
+RunSetup setUp(const Args& args) {
+  RunSetup r;
+  r.cfg = Config::fromFile(args.config);
+  for (const auto& o : args.overrides) r.cfg.setFromAssignment(o);
+  r.cam = CameraModel::load(r.cfg);
+  r.options = slam::SystemOptions::load(r.cfg);
+  r.stages = screening::stagesFor(r.options.screening);
+  r.seq = io::TumSequence::open(args.sequence);
+  r.frames = r.seq.size();
+  if (args.max_frames > 0) r.frames = std::min(r.frames, static_cast<size_t>(args.max_frames));
+  setUpBoxes(args, r);
+  if (!args.vocabulary.empty()) r.voc = vocabulary::Vocabulary::load(args.vocabulary);
   makeDirs(args.out);
-  // Synthetic sequences carry per-frame masks (masks/<rgb file name>): screening metrics.
-  const std::string mask_dir = joinPath(args.sequence, "masks");
-  const bool has_masks = dirExists(mask_dir);
+  r.mask_dir = joinPath(args.sequence, "masks");
+  r.has_masks = dirExists(r.mask_dir);
+  return r;
+}
 
-  slam::System system(cam, sys_opt, voc);
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
-  // Printed once the handlers are in place (the Ctrl-C test waits for this line).
-  std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s, vocabulary: %s%s\n", n,
-               args.sequence.c_str(), screening::toString(mode).c_str(), detector_name.c_str(),
-               args.vocabulary.empty() ? "none (no BoW)" : args.vocabulary.c_str(),
-               has_masks ? ", screening metrics from masks/" : "");
+void detectInto(const RunSetup& r, Prepared& p) {
+  if (!r.stages.detection) return;
+  if (!r.detector) {
+    auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
+    if (it != r.file_boxes.end()) p.boxes = it->second;
+    return;
+  }
+  Stopwatch sw;
+  try {
+    p.boxes = r.detector->detect(p.bgr);
+  } catch (const std::exception& e) {
+    p.warning = std::string("detector failed: ") + e.what();
+  }
+  p.detection_ms = sw.ms();
+}
 
-  // Worker: loads frame i and detects people in it (the detector is used by one task at a time).
-  auto prepare = [&](size_t i) {
-    Prepared p;
-    p.index = i;
-    p.stamp = seq.frames()[i].rgb_stamp;
-    try {
-      p.bgr = seq.loadRgb(i);
-      p.has_image = !p.bgr.empty();
-    } catch (const std::exception& e) {
-      p.warning = e.what();
-      return p;
-    }
-    try {
-      p.depth = seq.loadDepth(i, cam.depth_map_factor);
-    } catch (const std::exception& e) {
-      p.warning = std::string(e.what()) + " (tracked without depth)";
-      p.depth = cv::Mat();
-    }
-    if (needs_boxes) {
-      if (detector) {
-        Stopwatch sw;
-        try {
-          p.boxes = detector->detect(p.bgr);
-        } catch (const std::exception& e) {
-          p.warning = std::string("detector failed: ") + e.what();
-        }
-        p.detection_ms = sw.ms();
-      } else {
-        auto it = gt_boxes.find(std::llround(p.stamp * 1e6));
-        if (it != gt_boxes.end()) p.boxes = it->second;
-      }
-    }
-    if (has_masks) {
-      // A frame without a mask is simply not evaluated; an unreadable one is reported.
-      p.mask_path = joinPath(mask_dir, baseName(seq.frames()[i].rgb_path));
-      if (fileExists(p.mask_path)) {
-        try {
-          p.mask = screening::loadMask(p.mask_path);
-        } catch (const std::exception& e) {
-          p.warning += (p.warning.empty() ? "" : "; ") + std::string(e.what()) + " (frame not evaluated)";
-        }
-      }
-    }
+void loadMaskInto(const RunSetup& r, size_t i, Prepared& p) {
+  if (!r.has_masks) return;
+  // A frame without a mask is simply not evaluated; an unreadable one is reported.
+  p.mask_path = joinPath(r.mask_dir, baseName(r.seq.frames()[i].rgb_path));
+  if (!fileExists(p.mask_path)) return;
+  try {
+    p.mask = screening::loadMask(p.mask_path);
+  } catch (const std::exception& e) {
+    p.warning += (p.warning.empty() ? "" : "; ") + std::string(e.what()) + " (frame not evaluated)";
+  }
+}
+
+// The worker's task: loads frame i and detects people in it (the detector is used by one task
+// at a time).
+Prepared prepareFrame(const RunSetup& r, size_t i) {
+  Prepared p;
+  p.index = i;
+  p.stamp = r.seq.frames()[i].rgb_stamp;
+  try {
+    p.bgr = r.seq.loadRgb(i);
+    p.has_image = !p.bgr.empty();
+  } catch (const std::exception& e) {
+    p.warning = e.what();
     return p;
-  };
+  }
+  try {
+    p.depth = r.seq.loadDepth(i, r.cam.depth_map_factor);
+  } catch (const std::exception& e) {
+    p.warning = std::string(e.what()) + " (tracked without depth)";
+    p.depth = cv::Mat();
+  }
+  detectInto(r, p);
+  loadMaskInto(r, i, p);
+  return p;
+}
 
-  ProgressBar bar("yolo_slam_run", n);
-  std::vector<double> frame_ms;
+// What the frame loop counted.
+struct LoopResult {
   size_t skipped = 0, processed = 0, lost_reports = 0;
+  std::vector<double> frame_ms;
   MetricsAccumulator metrics;
+  double total_s = 0;
+  double fps() const { return total_s > 0 ? static_cast<double>(processed + skipped) / total_s : 0.0; }
+};
+
+// Every box screened, per frame, in the synthetic boxes.txt format: to inspect the detector
+// and the box tracker offline, or to score them against the ground truth.
+void writeScreenedBoxes(std::ofstream& out, double stamp, const detection::Boxes& boxes) {
+  int k = 0;
+  char line[160];
+  for (const auto& b : boxes) {
+    std::snprintf(line, sizeof line, "%.6f %d %s %.1f %.1f %.1f %.1f %.3f %d\n", stamp, k++,
+                  b.label.empty() ? "person" : b.label.c_str(), b.rect.x, b.rect.y, b.rect.x + b.rect.width,
+                  b.rect.y + b.rect.height, b.score, b.tracked ? 1 : 0);
+    out << line;
+  }
+}
+
+// Retention counts static keypoints inside the boxes this run used (none in modes off and
+// geometry); exact synthetic masks need no ignored border.
+void evaluateFrame(const slam::System& system, const Prepared& p, MetricsAccumulator& metrics) {
+  if (p.mask.empty()) return;
+  try {
+    metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, system.lastBoxes(), 0);
+    ++metrics.frames;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "\nwarning: %s: %s (frame not evaluated)\n", p.mask_path.c_str(), e.what());
+  }
+}
+
+// --realtime: frame i is due at its stamp's offset from the first frame's.
+void waitUntilDue(const Prepared& p, double stamp0, std::chrono::steady_clock::time_point wall0) {
+  const auto due = wall0 + std::chrono::duration<double>(p.stamp - stamp0);
+  std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
+}
+
+void trackFrame(slam::System& system, const Prepared& p, std::ofstream& boxes_out, LoopResult& res) {
+  if (!p.warning.empty()) std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s\n", p.index, p.stamp, p.warning.c_str());
+  if (p.detection_ms >= 0) system.recordDetectionTime(p.detection_ms);
+  if (!p.has_image) {
+    ++res.skipped;
+    return;
+  }
+  const slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
+  if (r.state != slam::TrackingState::Ok) ++res.lost_reports;
+  ++res.processed;
+  if (boxes_out.is_open()) writeScreenedBoxes(boxes_out, p.stamp, system.lastBoxes());
+  evaluateFrame(system, p, res.metrics);
+}
+
+LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system) {
+  LoopResult res;
+  const size_t n = setup.frames;
+  ProgressBar bar("yolo_slam_run", n);
   Stopwatch total;
   const auto wall0 = std::chrono::steady_clock::now();
-  const double stamp0 = n ? seq.frames()[0].rgb_stamp : 0;
-  // Every box screened, per frame, in the synthetic boxes.txt format: to inspect the detector
-  // and the box tracker offline, or to score them against the ground truth.
+  const double stamp0 = n ? setup.seq.frames()[0].rgb_stamp : 0;
   std::ofstream boxes_out;
-  if (needs_boxes) {
+  if (setup.stages.detection) {
     boxes_out.open(joinPath(args.out, "boxes_screened.txt"));
     boxes_out << "# rgb_stamp index label x1 y1 x2 y2 score tracked\n";
   }
+  auto prepare = [&setup](size_t i) { return prepareFrame(setup, i); };
   std::future<Prepared> next;
   if (n > 0) next = std::async(std::launch::async, prepare, size_t{0});
   for (size_t i = 0; i < n && !g_stop; ++i) {
@@ -380,113 +436,114 @@ int run(const Args& args) {
     Prepared p = next.get();
     // Detection of frame i+1 overlaps the tracking of frame i.
     if (i + 1 < n) next = std::async(std::launch::async, prepare, i + 1);
-    if (args.realtime) {
-      const auto due = wall0 + std::chrono::duration<double>(p.stamp - stamp0);
-      std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
-    }
-    if (!p.warning.empty()) std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s\n", i, p.stamp, p.warning.c_str());
-    if (p.detection_ms >= 0) system.recordDetectionTime(p.detection_ms);
-    if (!p.has_image) {
-      ++skipped;
-    } else {
-      slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
-      if (r.state != slam::TrackingState::Ok) ++lost_reports;
-      ++processed;
-      if (boxes_out.is_open()) {
-        int k = 0;
-        char line[160];
-        for (const auto& b : system.lastBoxes()) {
-          std::snprintf(line, sizeof line, "%.6f %d %s %.1f %.1f %.1f %.1f %.3f %d\n", p.stamp, k++,
-                        b.label.empty() ? "person" : b.label.c_str(), b.rect.x, b.rect.y,
-                        b.rect.x + b.rect.width, b.rect.y + b.rect.height, b.score, b.tracked ? 1 : 0);
-          boxes_out << line;
-        }
-      }
-      if (!p.mask.empty()) {
-        // Retention counts static keypoints inside the boxes this run used (none in modes
-        // off/geometry); exact synthetic masks need no ignored border.
-        try {
-          metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, system.lastBoxes(), 0);
-          ++metrics.frames;
-        } catch (const Error& e) {
-          std::fprintf(stderr, "\nwarning: %s: %s (frame not evaluated)\n", p.mask_path.c_str(), e.what());
-        }
-      }
-    }
-    frame_ms.push_back(fsw.ms());
+    if (args.realtime) waitUntilDue(p, stamp0, wall0);
+    trackFrame(system, p, boxes_out, res);
+    res.frame_ms.push_back(fsw.ms());
     char extra[96];
-    std::snprintf(extra, sizeof extra, "%s, lost %zu", slam::toString(system.state()), lost_reports);
+    std::snprintf(extra, sizeof extra, "%s, lost %zu", slam::toString(system.state()), res.lost_reports);
     bar.update(i + 1, extra);
   }
   if (next.valid()) next.wait();
   bar.finish();
-  const double total_s = total.ms() / 1000.0;
-  if (g_stop) std::fprintf(stderr, "interrupted: stopping after %zu frames and writing the results\n", processed + skipped);
+  res.total_s = total.ms() / 1000.0;
+  return res;
+}
 
-  system.waitForLocalMapping();
-  system.shutdown();
-  Trajectory traj = system.cameraTrajectory();
-  Trajectory kfs = system.keyframeTrajectory();
-  io::writeTrajectory(joinPath(args.out, "CameraTrajectory.txt"), traj);
-  io::writeTrajectory(joinPath(args.out, "KeyFrameTrajectory.txt"), kfs);
+struct AteSummary {
+  double rmse = NAN;
+  size_t pairs = 0;
+};
 
-  double ate_rmse = NAN;
-  size_t ate_pairs = 0;
-  if (seq.hasGroundTruth() && traj.size() >= 2) {
-    try {
-      eval::AteResult ate = eval::computeAte(seq.groundTruth(), traj);
-      ate_rmse = ate.stats.rmse;
-      ate_pairs = ate.stats.count;
-    } catch (const Error& e) {
-      std::fprintf(stderr, "warning: ATE not computed: %s\n", e.what());
-    }
+AteSummary ateOf(const io::TumSequence& seq, const Trajectory& traj) {
+  AteSummary a;
+  if (!seq.hasGroundTruth() || traj.size() < 2) return a;
+  try {
+    const eval::AteResult ate = eval::computeAte(seq.groundTruth(), traj);
+    a.rmse = ate.stats.rmse;
+    a.pairs = ate.stats.count;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "warning: ATE not computed: %s\n", e.what());
   }
+  return a;
+}
 
-  slam::SystemStats s = system.stats();
-  std::ostringstream js;
-  js << "{\n  \"sequence\": \"" << jsonEscape(args.sequence) << "\",\n  \"config\": \"" << jsonEscape(args.config)
-     << "\",\n  \"dynamic_mode\": \"" << screening::toString(mode) << "\",\n  \"boxes\": \""
-     << jsonEscape(detector_name) << "\",\n  \"interrupted\": " << (g_stop ? "true" : "false")
-     << ",\n  \"frames_skipped\": " << skipped << ",\n  \"trajectory_poses\": " << traj.size()
-     << ",\n  \"ate_rmse_m\": " << jsonNumber(ate_rmse, 6)
-     << ",\n  \"ate_pairs\": " << ate_pairs << ",\n  \"wall_time_s\": " << jsonNumber(total_s, 3)
-     << ",\n  \"fps\": " << jsonNumber(total_s > 0 ? (processed + skipped) / total_s : 0, 4) << ",\n"
-     << slam::statsCountsJson(s)
-     << ",\n  \"track_boxes\": " << (sys_opt.screening.track_boxes && needs_boxes ? "true" : "false")
-     << ",\n  \"propagate_labels\": "
-     << (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off ? "true" : "false")
-     << ",\n  \"static_box_veto\": "
-     << (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off ? "true" : "false")
-     << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
-     << ",\n  \"screening_metrics\": " << metrics.json() << ",\n"
-     << slam::statsTimingsJson(s, {{"frame", frame_ms}}) << "\n}\n";
-  const std::string stats_path = joinPath(args.out, "stats.json");
-  io::writeFileAtomic(stats_path, js.str());
+Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res, size_t poses,
+                  const AteSummary& ate, const slam::SystemStats& s) {
+  const screening::Stages& st = setup.stages;
+  Json j{{"sequence", args.sequence},
+         {"config", args.config},
+         {"dynamic_mode", screening::toString(setup.options.screening.mode)},
+         {"boxes", setup.boxes_source},
+         {"interrupted", g_stop != 0},
+         {"frames_skipped", res.skipped},
+         {"trajectory_poses", poses},
+         {"ate_rmse_m", jsonNumber(ate.rmse)},
+         {"ate_pairs", ate.pairs},
+         {"wall_time_s", jsonNumber(res.total_s)},
+         {"fps", jsonNumber(res.fps())}};
+  j.update(slam::statsCountsJson(s));
+  j["track_boxes"] = st.box_tracking;
+  j["propagate_labels"] = st.label_propagation;
+  j["static_box_veto"] = st.static_box_veto;
+  j["vocabulary"] = args.vocabulary;
+  j["screening_metrics"] = res.metrics.json();
+  j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}});
+  j["overrides"] = setup.cfg.overrides();
+  j["settings"] = setup.cfg.effective();
+  return j;
+}
 
+void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary& ate, const slam::SystemStats& s) {
   std::printf("frames %zu, tracked %zu, lost %zu, keyframes %zu, map points %zu\n", s.frames, s.tracked, s.lost,
               s.keyframes, s.map_points);
   const auto t = summarize(slam::extractionPlusTrackingMs(s));
-  std::printf("extraction+tracking median %.2f ms, p95 %.2f ms; %.1f frames/s overall\n", t.median, t.p95,
-              total_s > 0 ? (processed + skipped) / total_s : 0.0);
-  if (std::isfinite(ate_rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate_rmse, ate_pairs);
-  if (metrics.frames > 0)
+  std::printf("extraction+tracking median %.2f ms, p95 %.2f ms; %.1f frames/s overall\n", t.median, t.p95, res.fps());
+  if (std::isfinite(ate.rmse)) std::printf("ATE RMSE %.4f m over %zu poses\n", ate.rmse, ate.pairs);
+  const screening::ScreeningMetrics& m = res.metrics.sum;
+  if (res.metrics.frames > 0)
     std::printf("screening vs masks over %zu frames: dynamic recall %s (on people %s), static retention "
                 "in boxes %s, static dropped %s\n",
-                metrics.frames, percent(metrics.sum.dynamic_dropped, metrics.sum.dynamic_total).c_str(),
-                percent(metrics.sum.person_dropped, metrics.sum.person_total).c_str(),
-                percent(metrics.sum.static_in_boxes_kept, metrics.sum.static_in_boxes).c_str(),
-                percent(metrics.sum.static_dropped, metrics.sum.static_total).c_str());
-  if (sys_opt.screening.track_boxes && needs_boxes)
-    std::printf("boxes screened: %ld from the detector, %ld carried by the box tracker\n", s.boxes_detected,
-                s.boxes_tracked);
-  if (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off)
-    std::printf("label propagation marked %ld keypoints dynamic\n", s.keypoints_propagated);
-  if (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off)
-    std::printf("static-box veto: %ld boxes left alone, %ld screened keypoints kept\n",
-                s.boxes_vetoed, s.keypoints_vetoed);
-  if (metrics.frames > 0)
+                res.metrics.frames, percent(m.dynamic_dropped, m.dynamic_total).c_str(),
+                percent(m.person_dropped, m.person_total).c_str(),
+                percent(m.static_in_boxes_kept, m.static_in_boxes).c_str(),
+                percent(m.static_dropped, m.static_total).c_str());
+  if (setup.stages.box_tracking)
+    std::printf("boxes screened: %ld from the detector, %ld carried by the box tracker\n", s.boxes.detected,
+                s.boxes.tracked);
+  if (setup.stages.label_propagation)
+    std::printf("label propagation marked %d keypoints dynamic\n", s.temporal.propagated);
+  if (setup.stages.static_box_veto)
+    std::printf("static-box veto: %d boxes left alone, %d screened keypoints kept\n", s.temporal.boxes_vetoed,
+                s.temporal.vetoed);
+  if (res.metrics.frames > 0)
     std::printf("dynamic keypoints outside every box: %s dropped\n",
-                percent(metrics.sum.dynamic_outside_dropped, metrics.sum.dynamic_outside_boxes).c_str());
+                percent(m.dynamic_outside_dropped, m.dynamic_outside_boxes).c_str());
+}
+
+int run(const Args& args) {
+  RunSetup setup = setUp(args);
+  slam::System system(setup.cam, setup.options, setup.voc);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  // Printed once the handlers are in place (the Ctrl-C test waits for this line).
+  std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s, vocabulary: %s%s\n",
+               setup.frames, args.sequence.c_str(), screening::toString(setup.options.screening.mode).c_str(),
+               setup.boxes_source.c_str(), args.vocabulary.empty() ? "none (no BoW)" : args.vocabulary.c_str(),
+               setup.has_masks ? ", screening metrics from masks/" : "");
+
+  const LoopResult res = processFrames(args, setup, system);
+  if (g_stop)
+    std::fprintf(stderr, "interrupted: stopping after %zu frames and writing the results\n", res.processed + res.skipped);
+
+  system.waitForLocalMapping();
+  system.shutdown();
+  const Trajectory traj = system.cameraTrajectory();
+  io::writeTrajectory(joinPath(args.out, "CameraTrajectory.txt"), traj);
+  io::writeTrajectory(joinPath(args.out, "KeyFrameTrajectory.txt"), system.keyframeTrajectory());
+  const AteSummary ate = ateOf(setup.seq, traj);
+  const slam::SystemStats s = system.stats();
+  io::writeFileAtomic(joinPath(args.out, "stats.json"), dumpJson(runStatsJson(args, setup, res, traj.size(), ate, s)));
+  printSummary(setup, res, ate, s);
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;
 }

@@ -47,8 +47,36 @@ Config Config::fromString(const std::string& yaml, const std::string& name) {
 }
 
 cv::FileNode Config::node(const std::string& key) const {
+  const auto it = override_fs_.find(key);
+  if (it != override_fs_.end()) return (*it->second)["v"];
   if (!fs_) return cv::FileNode();
   return (*fs_)[key];
+}
+
+void Config::set(const std::string& key, const std::string& value) {
+  if (key.empty()) throw Error("override '=" + value + "': the key is empty; use Key=value");
+  const std::string name = "override " + key + "=" + value;
+  override_fs_[key] = openStorage("%YAML:1.0\nv: " + value + "\n", true, name);
+  override_text_[key] = value;
+}
+
+void Config::setFromAssignment(const std::string& assignment) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string::npos)
+    throw Error("override '" + assignment + "' has no '='; use Key=value, e.g. Screening.mode=detect");
+  set(assignment.substr(0, eq), assignment.substr(eq + 1));
+}
+
+void Config::record(const std::string& key, Json value) const {
+  std::lock_guard<std::mutex> lk(record_->mutex);
+  record_->values[key] = std::move(value);
+}
+
+Json Config::effective() const {
+  std::lock_guard<std::mutex> lk(record_->mutex);
+  Json out = Json::object();
+  for (const auto& kv : record_->values) out[kv.first] = kv.second;
+  return out;
 }
 
 bool Config::has(const std::string& key) const {
@@ -62,56 +90,74 @@ void Config::fail(const std::string& key, const std::string& why) const {
 
 double Config::getDouble(const std::string& key, double def) const {
   cv::FileNode n = node(key);
-  if (n.empty() || n.isNone()) return def;
-  if (!n.isReal() && !n.isInt()) fail(key, "must be a number");
-  return static_cast<double>(n);
+  double v = def;
+  if (!n.empty() && !n.isNone()) {
+    if (!n.isReal() && !n.isInt()) fail(key, "must be a number");
+    v = static_cast<double>(n);
+  }
+  record(key, jsonNumber(v));
+  return v;
 }
 
 int Config::getInt(const std::string& key, int def) const {
   cv::FileNode n = node(key);
-  if (n.empty() || n.isNone()) return def;
-  if (n.isInt()) return static_cast<int>(n);
-  if (n.isReal()) {
-    double v = static_cast<double>(n);
-    if (v != static_cast<double>(static_cast<int>(v))) fail(key, "must be an integer");
-    return static_cast<int>(v);
+  int v = def;
+  if (n.isInt()) {
+    v = static_cast<int>(n);
+  } else if (n.isReal()) {
+    const double d = static_cast<double>(n);
+    if (d != static_cast<double>(static_cast<int>(d))) fail(key, "must be an integer");
+    v = static_cast<int>(d);
+  } else if (!n.empty() && !n.isNone()) {
+    fail(key, "must be an integer");
   }
-  fail(key, "must be an integer");
+  record(key, v);
+  return v;
 }
 
 bool Config::getBool(const std::string& key, bool def) const {
   cv::FileNode n = node(key);
-  if (n.empty() || n.isNone()) return def;
-  if (n.isInt()) return static_cast<int>(n) != 0;
-  if (n.isString()) {
-    std::string s = static_cast<std::string>(n);
-    if (s == "true" || s == "True" || s == "1") return true;
-    if (s == "false" || s == "False" || s == "0") return false;
+  bool v = def;
+  if (n.isInt()) {
+    v = static_cast<int>(n) != 0;
+  } else if (n.isString()) {
+    const std::string s = static_cast<std::string>(n);
+    if (s == "true" || s == "True" || s == "1") v = true;
+    else if (s == "false" || s == "False" || s == "0") v = false;
+    else fail(key, "must be true/false or 1/0");
+  } else if (!n.empty() && !n.isNone()) {
+    fail(key, "must be true/false or 1/0");
   }
-  fail(key, "must be true/false or 1/0");
+  record(key, v);
+  return v;
 }
 
 std::string Config::getString(const std::string& key, const std::string& def) const {
   cv::FileNode n = node(key);
-  if (n.empty() || n.isNone()) return def;
-  if (!n.isString()) fail(key, "must be a string");
-  return static_cast<std::string>(n);
+  std::string v = def;
+  if (!n.empty() && !n.isNone()) {
+    if (!n.isString()) fail(key, "must be a string");
+    v = static_cast<std::string>(n);
+  }
+  record(key, v);
+  return v;
 }
 
 std::vector<std::string> Config::getStringList(const std::string& key,
                                                const std::vector<std::string>& def) const {
   cv::FileNode n = node(key);
-  if (n.empty() || n.isNone()) return def;
-  std::vector<std::string> out;
+  std::vector<std::string> out = def;
   if (n.isString()) {
-    out.push_back(static_cast<std::string>(n));
-    return out;
+    out = {static_cast<std::string>(n)};
+  } else if (!n.empty() && !n.isNone()) {
+    if (!n.isSeq()) fail(key, "must be a list of strings");
+    out.clear();
+    for (const auto& item : n) {
+      if (!item.isString()) fail(key, "must be a list of strings");
+      out.push_back(static_cast<std::string>(item));
+    }
   }
-  if (!n.isSeq()) fail(key, "must be a list of strings");
-  for (const auto& item : n) {
-    if (!item.isString()) fail(key, "must be a list of strings");
-    out.push_back(static_cast<std::string>(item));
-  }
+  record(key, out);
   return out;
 }
 

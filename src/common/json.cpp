@@ -1,38 +1,25 @@
 #include "yolo_slam/common/json.h"
 
+#include "yolo_slam/common/error.h"
+
 #include <cmath>
-#include <cstdio>
 
 namespace yolo_slam {
 
-std::string jsonEscape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size() + 2);
-  for (char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
+Json jsonNumber(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json jsonRatio(long num, long den) {
+  return den > 0 ? Json(static_cast<double>(num) / static_cast<double>(den)) : Json(nullptr);
 }
 
-std::string jsonNumber(double v, int precision) {
-  if (!std::isfinite(v)) return "null";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*g", precision, v);
-  return buf;
+std::string dumpJson(const Json& j) { return j.dump(2) + "\n"; }
+
+Json parseJson(const std::string& text, const std::string& name) {
+  try {
+    return Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    throw Error(name + ": not valid JSON (byte " + std::to_string(e.byte) + "): " + e.what());
+  }
 }
 
 }  // namespace yolo_slam

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 
 namespace yolo_slam {
@@ -23,11 +22,8 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
-std::string summaryJsonMs(const Summary& s) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "{\"count\": %zu, \"median_ms\": %.3f, \"mean_ms\": %.3f, \"p95_ms\": %.3f}",
-                s.count, s.median, s.mean, s.p95);
-  return buf;
+Json summaryJsonMs(const Summary& s) {
+  return Json{{"count", s.count}, {"median_ms", s.median}, {"mean_ms", s.mean}, {"p95_ms", s.p95}};
 }
 
 }  // namespace yolo_slam

@@ -26,16 +26,13 @@ void drawBoxes(cv::Mat& image, const Boxes& boxes) {
   }
 }
 
-std::string boxesJson(const Boxes& boxes) {
-  std::string s = "[";
-  for (size_t i = 0; i < boxes.size(); ++i) {
-    const Box& b = boxes[i];
-    s += (i ? "," : "") + std::string("{\"class\":\"") + jsonEscape(b.label) +
-         "\",\"score\":" + jsonNumber(b.score, 4) + ",\"x1\":" + jsonNumber(b.rect.x, 6) +
-         ",\"y1\":" + jsonNumber(b.rect.y, 6) + ",\"x2\":" + jsonNumber(b.rect.x + b.rect.width, 6) +
-         ",\"y2\":" + jsonNumber(b.rect.y + b.rect.height, 6) + "}";
-  }
-  return s + "]";
+Json boxesJson(const Boxes& boxes) {
+  Json out = Json::array();
+  for (const Box& b : boxes)
+    out.push_back({{"class", b.label}, {"score", jsonNumber(b.score)}, {"x1", jsonNumber(b.rect.x)},
+                   {"y1", jsonNumber(b.rect.y)}, {"x2", jsonNumber(b.rect.x + b.rect.width)},
+                   {"y2", jsonNumber(b.rect.y + b.rect.height)}});
+  return out;
 }
 
 }  // namespace detection

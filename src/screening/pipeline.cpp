@@ -3,12 +3,20 @@
 namespace yolo_slam {
 namespace screening {
 
+Stages stagesFor(const ScreeningOptions& o) {
+  Stages s;
+  s.detection = o.mode == DynamicMode::Detect || o.mode == DynamicMode::DetectGeometry;
+  s.box_tracking = s.detection && o.track_boxes;
+  const bool screens = o.mode != DynamicMode::Off;
+  s.label_propagation = screens && o.propagate_labels;
+  s.static_box_veto = screens && o.static_box_veto;
+  return s;
+}
+
 ScreeningPipeline::ScreeningPipeline(const ScreeningOptions& options) : screener_(options) {
-  const DynamicMode m = options.mode;
-  if (options.track_boxes && (m == DynamicMode::Detect || m == DynamicMode::DetectGeometry))
-    box_tracker_ = std::make_unique<BoxTracker>(BoxTrackerOptions::from(options));
-  const TemporalOptions topt = TemporalOptions::from(options);
-  if (topt.enabled() && m != DynamicMode::Off) temporal_ = std::make_unique<TemporalScreening>(topt);
+  const Stages stages = stagesFor(options);
+  if (stages.box_tracking) box_tracker_ = std::make_unique<BoxTracker>(BoxTrackerOptions::from(options));
+  if (stages.temporal()) temporal_ = std::make_unique<TemporalScreening>(TemporalOptions::from(options));
 }
 
 PipelineResult ScreeningPipeline::process(features::FeatureFrame& frame,

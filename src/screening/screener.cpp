@@ -501,21 +501,40 @@ ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
   return *this;
 }
 
-std::string ScreeningMetrics::toJson() const {
-  std::ostringstream os;
-  os.precision(6);
-  os << "{\"dynamic_total\":" << dynamic_total << ",\"dynamic_dropped\":" << dynamic_dropped
-     << ",\"dynamic_recall\":" << dynamicRecall()
-     << ",\"dynamic_outside_boxes\":" << dynamic_outside_boxes
-     << ",\"dynamic_outside_dropped\":" << dynamic_outside_dropped
-     << ",\"dynamic_recall_in_boxes\":" << dynamicRecallInBoxes()
-     << ",\"person_total\":" << person_total << ",\"person_dropped\":" << person_dropped
-     << ",\"person_recall\":" << personRecall()
-     << ",\"static_in_boxes\":" << static_in_boxes
-     << ",\"static_in_boxes_kept\":" << static_in_boxes_kept
-     << ",\"static_retention\":" << staticRetention() << ",\"static_total\":" << static_total
-     << ",\"static_dropped\":" << static_dropped << "}";
-  return os.str();
+void to_json(Json& j, const ScreeningMetrics& m) {
+  j = Json{{"dynamic_keypoints", m.dynamic_total},
+           {"dropped", m.dynamic_dropped},
+           {"dynamic_recall", jsonRatio(m.dynamic_dropped, m.dynamic_total)},
+           {"dynamic_outside_boxes", m.dynamic_outside_boxes},
+           {"dynamic_outside_dropped", m.dynamic_outside_dropped},
+           {"dynamic_recall_in_boxes", jsonRatio(m.dynamic_dropped - m.dynamic_outside_dropped,
+                                                 m.dynamic_total - m.dynamic_outside_boxes)},
+           {"person_keypoints", m.person_total},
+           {"person_dropped", m.person_dropped},
+           {"person_recall", jsonRatio(m.person_dropped, m.person_total)},
+           {"static_in_boxes", m.static_in_boxes},
+           {"kept", m.static_in_boxes_kept},
+           {"static_retention", jsonRatio(m.static_in_boxes_kept, m.static_in_boxes)},
+           {"static_keypoints", m.static_total},
+           {"static_dropped", m.static_dropped},
+           {"static_drop_rate", jsonRatio(m.static_dropped, m.static_total)}};
+}
+
+ScreeningStats& ScreeningStats::operator+=(const ScreeningStats& o) {
+  in_boxes += o.in_boxes;
+  kept += o.kept;
+  dropped += o.dropped;
+  iterations += o.iterations;
+  ms += o.ms;
+  flat_boxes += o.flat_boxes;
+  silhouette += o.silhouette;
+  return *this;
+}
+
+void to_json(Json& j, const ScreeningStats& s) {
+  j = Json{{"in_boxes", s.in_boxes},     {"kept", s.kept},
+           {"dropped", s.dropped},       {"silhouette", s.silhouette},
+           {"flat_boxes", s.flat_boxes}, {"iterations", s.iterations}};
 }
 
 ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,

@@ -143,11 +143,12 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
   }
   cv::Matx33d R;
   cv::Vec3d t;
-  st.motion_ok = usable && estimateMotion(frame, match, cam, R, t, st.motion_inliers);
+  const bool motion_ok = usable && estimateMotion(frame, match, cam, R, t, st.motion_inliers);
+  st.motion_frames = motion_ok ? 1 : 0;
   // Per keypoint: -1 untested (no match, or no depth in the previous frame: the point's static
   // position is unknown), 0 moved, 1 static-consistent.
   std::vector<int8_t> verdict(n, -1);
-  if (st.motion_ok) {
+  if (motion_ok) {
     const auto& kun = undistorted(frame);
     for (size_t i = 0; i < n; ++i) {
       const int j = match[i];
@@ -168,7 +169,7 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
       st.static_consistent += consistent ? 1 : 0;
     }
   }
-  if (st.motion_ok && opt_.static_box_veto) {
+  if (motion_ok && opt_.static_box_veto) {
     std::vector<cv::Rect2f> regions;
     for (const auto& b : boxes) regions.push_back(dilate(b.rect, opt_.box_dilation));
     std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
@@ -201,7 +202,7 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
       }
     }
   }
-  if (st.motion_ok && opt_.propagate_labels) {
+  if (motion_ok && opt_.propagate_labels) {
     for (size_t i = 0; i < n; ++i) {
       const int j = match[i];
       if (verdict[i] != 0 || frame.dynamic[i] || !isDynamic(prev_, j) || prev_age_[j] >= opt_.propagate_max_age)
@@ -232,6 +233,24 @@ void TemporalScreening::clear() {
   prev_ = features::FeatureFrame();
   prev_X_.clear();
   prev_age_.clear();
+}
+
+TemporalStats& TemporalStats::operator+=(const TemporalStats& o) {
+  motion_frames += o.motion_frames;
+  motion_inliers += o.motion_inliers;
+  matched += o.matched;
+  static_consistent += o.static_consistent;
+  propagated += o.propagated;
+  boxes_vetoed += o.boxes_vetoed;
+  vetoed += o.vetoed;
+  return *this;
+}
+
+void to_json(Json& j, const TemporalStats& s) {
+  j = Json{{"matched", s.matched},           {"static_consistent", s.static_consistent},
+           {"motion_frames", s.motion_frames}, {"motion_inliers", s.motion_inliers},
+           {"propagated", s.propagated},     {"boxes_vetoed", s.boxes_vetoed},
+           {"vetoed", s.vetoed}};
 }
 
 }  // namespace screening

@@ -19,7 +19,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <unordered_map>
 
 namespace yolo_slam {
@@ -123,24 +122,15 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   const screening::ScreeningStats& ss = screened.stats;
   detection::Boxes& used = screened.boxes;
   const double screening_ms = sw.ms();
-  long n_tracked = 0;
-  for (const auto& b : used) n_tracked += b.tracked ? 1 : 0;
+  BoxCounts box_counts;
+  for (const auto& b : used) ++(b.tracked ? box_counts.tracked : box_counts.detected);
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     stats_.extraction_ms.push_back(extraction_ms);
     stats_.screening_ms.push_back(screening_ms);
-    stats_.keypoints_in_boxes += ss.in_boxes;
-    stats_.keypoints_kept += ss.kept;
-    stats_.keypoints_dropped += ss.dropped;
-    stats_.keypoints_silhouette += ss.silhouette;
-    stats_.keypoints_propagated += screened.temporal.propagated;
-    stats_.keypoints_vetoed += screened.temporal.vetoed;
-    stats_.boxes_vetoed += screened.temporal.boxes_vetoed;
-    stats_.temporal_matched += screened.temporal.matched;
-    stats_.temporal_static_consistent += screened.temporal.static_consistent;
-    stats_.temporal_motion_frames += screened.temporal.motion_ok ? 1 : 0;
-    stats_.boxes_tracked += n_tracked;
-    stats_.boxes_detected += static_cast<long>(used.size()) - n_tracked;
+    stats_.keypoints += ss;
+    stats_.temporal += screened.temporal;
+    stats_.boxes += box_counts;
   }
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
@@ -324,23 +314,28 @@ SystemStats System::stats() const {
   return s;
 }
 
-std::string statsCountsJson(const SystemStats& s) {
-  std::ostringstream o;
-  o << "  \"frames\": " << s.frames << ",\n  \"tracked\": " << s.tracked << ",\n  \"lost\": " << s.lost
-    << ",\n  \"keyframes\": " << s.keyframes << ",\n  \"keyframes_culled\": " << s.keyframes_culled
-    << ",\n  \"map_points\": " << s.map_points << ",\n  \"map_resets\": " << s.resets
-    << ",\n  \"relocalizations\": " << s.relocalizations << ",\n  \"loops_closed\": " << s.loops_closed
-    << ",\n  \"global_bundle_adjustments\": " << s.global_bas
-    << ",\n  \"keypoints\": {\"in_boxes\": " << s.keypoints_in_boxes << ", \"kept\": " << s.keypoints_kept
-    << ", \"dropped\": " << s.keypoints_dropped << ", \"silhouette\": " << s.keypoints_silhouette
-    << ", \"propagated\": " << s.keypoints_propagated
-    << ", \"vetoed\": " << s.keypoints_vetoed << "}"
-    << ",\n  \"temporal\": {\"matched\": " << s.temporal_matched
-    << ", \"static_consistent\": " << s.temporal_static_consistent
-    << ", \"motion_frames\": " << s.temporal_motion_frames << ", \"boxes_vetoed\": " << s.boxes_vetoed << "}"
-    << ",\n  \"boxes_screened\": {\"detected\": " << s.boxes_detected << ", \"tracked\": " << s.boxes_tracked
-    << "}";
-  return o.str();
+BoxCounts& BoxCounts::operator+=(const BoxCounts& o) {
+  detected += o.detected;
+  tracked += o.tracked;
+  return *this;
+}
+
+void to_json(Json& j, const BoxCounts& b) { j = Json{{"detected", b.detected}, {"tracked", b.tracked}}; }
+
+Json statsCountsJson(const SystemStats& s) {
+  return Json{{"frames", s.frames},
+              {"tracked", s.tracked},
+              {"lost", s.lost},
+              {"keyframes", s.keyframes},
+              {"keyframes_culled", s.keyframes_culled},
+              {"map_points", s.map_points},
+              {"map_resets", s.resets},
+              {"relocalizations", s.relocalizations},
+              {"loops_closed", s.loops_closed},
+              {"global_bundle_adjustments", s.global_bas},
+              {"keypoints", s.keypoints},
+              {"temporal", s.temporal},
+              {"boxes_screened", s.boxes}};
 }
 
 std::vector<double> extractionPlusTrackingMs(const SystemStats& s) {
@@ -350,25 +345,23 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s) {
   return et;
 }
 
-std::string statsTimingsJson(const SystemStats& s,
-                             const std::vector<std::pair<std::string, std::vector<double>>>& extra) {
-  const std::vector<double> et = extractionPlusTrackingMs(s);
-  std::vector<std::pair<std::string, const std::vector<double>*>> stages = {
-      {"extraction", &s.extraction_ms}, {"screening", &s.screening_ms},
-      {"tracking", &s.tracking_ms},     {"extraction_plus_tracking", &et},
-      {"local_mapping", &s.local_mapping_ms}, {"detection", &s.detection_ms}};
-  for (const auto& e : extra) stages.emplace_back(e.first, &e.second);
-  std::ostringstream o;
-  o << "  \"timings\": {";
-  for (size_t k = 0; k < stages.size(); ++k)
-    o << (k ? ",\n    \"" : "\n    \"") << stages[k].first << "\": " << summaryJsonMs(summarize(*stages[k].second));
-  o << "\n  }";
-  return o.str();
+Json statsTimingsJson(const SystemStats& s,
+                      const std::vector<std::pair<std::string, std::vector<double>>>& extra) {
+  Json t{{"extraction", summaryJsonMs(summarize(s.extraction_ms))},
+         {"screening", summaryJsonMs(summarize(s.screening_ms))},
+         {"tracking", summaryJsonMs(summarize(s.tracking_ms))},
+         {"extraction_plus_tracking", summaryJsonMs(summarize(extractionPlusTrackingMs(s)))},
+         {"local_mapping", summaryJsonMs(summarize(s.local_mapping_ms))},
+         {"detection", summaryJsonMs(summarize(s.detection_ms))}};
+  for (const auto& e : extra) t[e.first] = summaryJsonMs(summarize(e.second));
+  return t;
 }
 
 std::string System::statsJson() const {
   const SystemStats s = stats();
-  return "{\n" + statsCountsJson(s) + ",\n" + statsTimingsJson(s) + "\n}\n";
+  Json j = statsCountsJson(s);
+  j["timings"] = statsTimingsJson(s);
+  return dumpJson(j);
 }
 
 }  // namespace slam

@@ -56,3 +56,38 @@ TEST(Timing, SummaryMedianAndP95) {
   EXPECT_DOUBLE_EQ(s.p95, 5);
   EXPECT_EQ(summarize({}).count, 0u);
 }
+
+TEST(Config, OverridesWinOverTheFileAndKeepTheirTypes) {
+  Config c = Config::fromString("Screening.mode: \"detect\"\nORBextractor.nFeatures: 1000\n", "s.yaml");
+  c.setFromAssignment("Screening.mode=off");
+  c.set("ORBextractor.nFeatures", "500");
+  c.set("Detector.extraModels", "[a, b]");
+  c.setFromAssignment("Screening.boxDilation=0.1");
+  EXPECT_EQ(c.getString("Screening.mode", ""), "off");
+  EXPECT_EQ(c.getInt("ORBextractor.nFeatures", 0), 500);
+  EXPECT_EQ(c.getStringList("Detector.extraModels", {}), (std::vector<std::string>{"a", "b"}));
+  EXPECT_DOUBLE_EQ(c.getDouble("Screening.boxDilation", 0.05), 0.1);
+  EXPECT_TRUE(c.has("Screening.boxDilation"));
+  EXPECT_EQ(c.overrides().size(), 4u);
+  // A wrong type is still an error naming the key.
+  c.set("ORBextractor.nFeatures", "many");
+  EXPECT_THROW(c.getInt("ORBextractor.nFeatures", 0), Error);
+  EXPECT_THROW(c.setFromAssignment("no-equals-sign"), Error);
+  EXPECT_THROW(c.set("", "1"), Error);
+}
+
+TEST(Config, EffectiveRecordsWhatEveryGetterReturned) {
+  Config c = Config::fromString("Camera.fx: 535.4\nUnread.key: 3\n");
+  const Config copy = c;  // copies share the record
+  c.getDouble("Camera.fx", 0);
+  copy.getInt("Absent.key", 7);
+  c.getBool("Flag", true);
+  c.getString("Name", "x");
+  const Json e = c.effective();
+  EXPECT_DOUBLE_EQ(e["Camera.fx"].get<double>(), 535.4);
+  EXPECT_EQ(e["Absent.key"], 7);
+  EXPECT_EQ(e["Flag"], true);
+  EXPECT_EQ(e["Name"], "x");
+  EXPECT_FALSE(e.contains("Unread.key"));
+  EXPECT_EQ(copy.effective(), e);
+}

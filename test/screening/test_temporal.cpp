@@ -114,7 +114,7 @@ TEST(Temporal, StaticSceneIsStaticConsistentUnderCameraMotion) {
   ts.apply(f0, {}, camera());
   features::FeatureFrame f1 = render(w, 0.03, 0, false);  // 3 cm sideways: ~5 px of parallax
   const TemporalStats st = ts.apply(f1, {}, camera());
-  EXPECT_TRUE(st.motion_ok);
+  EXPECT_TRUE(st.motionOk());
   EXPECT_EQ(st.matched, 200);
   EXPECT_EQ(st.static_consistent, 200);
   EXPECT_EQ(st.propagated, 0);
@@ -135,7 +135,7 @@ TEST(Temporal, LabelsOfAMovingPersonPropagateWhereTheDetectorMissedThem) {
   features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
   ASSERT_EQ(f1.size(), w.points.size());
   const TemporalStats st = ts.apply(f1, {}, camera());
-  ASSERT_TRUE(st.motion_ok);
+  ASSERT_TRUE(st.motionOk());
   EXPECT_EQ(st.propagated, 60);
   EXPECT_EQ(countDynamic(f1, w, true), 60);
   EXPECT_EQ(countDynamic(f1, w, false), 0);
@@ -151,7 +151,7 @@ TEST(Temporal, WronglyDroppedBackgroundDoesNotPropagate) {
   ts.apply(f0, {}, camera());
   features::FeatureFrame f1 = render(w, 0.02, 0, false);
   const TemporalStats st = ts.apply(f1, {}, camera());
-  ASSERT_TRUE(st.motion_ok);
+  ASSERT_TRUE(st.motionOk());
   EXPECT_EQ(st.propagated, 0);
   EXPECT_EQ(f1.countDynamic(), 0u);
 }
@@ -214,7 +214,7 @@ TEST(Temporal, StaticBoxVetoKeepsAnUnsureFalseDetectionButNotAWalkingPerson) {
   ASSERT_TRUE((person & picture).empty());
   // Scores below staticBoxMaxScore (0.8): both boxes may be vetoed, only the picture is.
   const TemporalStats st = ts.apply(f1, {box(picture, 0.5f), box(person, 0.6f)}, camera());
-  ASSERT_TRUE(st.motion_ok);
+  ASSERT_TRUE(st.motionOk());
   EXPECT_EQ(st.boxes_vetoed, 1);
   EXPECT_EQ(st.vetoed, wall_dropped);
   EXPECT_EQ(countDynamic(f1, w, false), 0);   // the picture's keypoints are kept
@@ -227,7 +227,7 @@ TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
   VetoScene v = vetoScene(ts);
   const int wall_dropped = countDynamic(v.f1, v.w, false);
   const TemporalStats st = ts.apply(v.f1, {box(v.picture, 0.95f), box(v.person, 0.95f)}, camera());
-  ASSERT_TRUE(st.motion_ok);
+  ASSERT_TRUE(st.motionOk());
   EXPECT_EQ(st.boxes_vetoed, 0);
   EXPECT_EQ(countDynamic(v.f1, v.w, false), wall_dropped);
 }
@@ -240,7 +240,7 @@ TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
   ts.apply(f0, {}, camera());
   features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
   const TemporalStats st = ts.apply(f1, {}, camera());
-  EXPECT_FALSE(st.motion_ok);
+  EXPECT_FALSE(st.motionOk());
   EXPECT_EQ(st.propagated, 0);
   EXPECT_EQ(f1.countDynamic(), 0u);
 }

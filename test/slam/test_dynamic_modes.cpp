@@ -54,10 +54,10 @@ TEST(SlamDynamicModes, DetectGeometryFarBelowOffOnWalkingHalf) {
   std::printf("walking_half, %zu frames (%zu with a detection): ATE RMSE off %.4f m, detect+geometry %.4f m "
               "(%zu tracked; keypoints in boxes %zu, dropped %zu)\n",
               gen.size(), frames_with_people, ate_off, ate_dg, tracked_dg,
-              static_cast<size_t>(st.keypoints_in_boxes), static_cast<size_t>(st.keypoints_dropped));
+              static_cast<size_t>(st.keypoints.in_boxes), static_cast<size_t>(st.keypoints.dropped));
   EXPECT_GT(frames_with_people, gen.size() / 2);
   EXPECT_EQ(tracked_dg, gen.size());
-  EXPECT_GT(st.keypoints_dropped, 0);
+  EXPECT_GT(st.keypoints.dropped, 0);
   EXPECT_LT(ate_dg, 0.03);
   // "Far below": at least a factor of 5 (measured: about 20).
   EXPECT_LT(ate_dg * 5.0, ate_off);

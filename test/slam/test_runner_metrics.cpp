@@ -2,6 +2,7 @@
 // folder): screening metrics against the masks in stats.json, corrupt/missing masks, default
 // and explicit vocabulary/config handling, and Ctrl-C (SIGINT to the running child) still
 // writing the trajectory so far and a valid stats.json.
+#include "yolo_slam/common/json.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/sim/generator.h"
 
@@ -46,28 +47,15 @@ size_t lineCount(const std::string& path) {
   return n;
 }
 
-// The JSON object (braces included) that follows "key": in text; "" if absent.
-std::string jsonObject(const std::string& text, const std::string& key) {
-  const auto k = text.find("\"" + key + "\":");
-  if (k == std::string::npos) return "";
-  const auto b = text.find_first_not_of(" ", k + key.size() + 3);
-  if (b == std::string::npos || text[b] != '{') return text.substr(b, text.find_first_of(",\n", b) - b);
-  int depth = 0;
-  for (size_t i = b; i < text.size(); ++i) {
-    depth += text[i] == '{' ? 1 : text[i] == '}' ? -1 : 0;
-    if (depth == 0) return text.substr(b, i - b + 1);
-  }
-  return "";
+// OUT/stats.json, parsed.
+Json statsOf(const std::string& out) {
+  const std::string path = joinPath(out, "stats.json");
+  return parseJson(readAll(path), path);
 }
 
-// The number after "key": in text; NaN if absent or not a number.
-double jsonNumberOf(const std::string& text, const std::string& key) {
-  const auto k = text.find("\"" + key + "\":");
-  if (k == std::string::npos) return NAN;
-  const char* s = text.c_str() + k + key.size() + 3;
-  char* end = nullptr;
-  const double v = std::strtod(s, &end);
-  return end == s ? NAN : v;
+// The number at `key` of a JSON object; NaN if absent or not a number.
+double numberOf(const Json& j, const std::string& key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
 
 // A started child with stdout/stderr redirected to files.
@@ -148,32 +136,30 @@ TEST_F(RunnerMetrics, GroundTruthBoxesGiveHighRecall) {
       << so << se;
   EXPECT_NE(se.find("vocab/yolo_slam_orb_k10_L4.vocab"), std::string::npos) << se;
   EXPECT_NE(so.find("dynamic recall"), std::string::npos) << so;
-  const std::string js = readAll(joinPath(out, "stats.json"));
-  const std::string m = jsonObject(js, "screening_metrics");
-  ASSERT_FALSE(m.empty()) << js;
-  ASSERT_EQ(m[0], '{') << js;
-  EXPECT_EQ(jsonNumberOf(m, "frames"), kFrames) << m;
-  const double dyn = jsonNumberOf(m, "dynamic_keypoints"), dropped = jsonNumberOf(m, "dropped");
-  EXPECT_GT(dyn, 100) << m;  // people fill a good part of walking_xyz frames
-  EXPECT_LE(dropped, dyn) << m;
-  const double recall = jsonNumberOf(m, "dynamic_recall");
-  EXPECT_NEAR(recall, dropped / dyn, 1e-3) << m;
-  EXPECT_GT(recall, 0.5) << m;
-  const double sib = jsonNumberOf(m, "static_in_boxes"), kept = jsonNumberOf(m, "kept");
-  EXPECT_GT(sib, 0) << m;
-  EXPECT_LE(kept, sib) << m;
-  const double retention = jsonNumberOf(m, "static_retention");
-  EXPECT_NEAR(retention, kept / sib, 1e-3) << m;
+  const Json js = statsOf(out);
+  const Json m = js["screening_metrics"];
+  ASSERT_TRUE(m.is_object()) << js.dump();
+  EXPECT_EQ(numberOf(m, "frames"), kFrames) << m.dump();
+  const double dyn = numberOf(m, "dynamic_keypoints"), dropped = numberOf(m, "dropped");
+  EXPECT_GT(dyn, 100) << m.dump();  // people fill a good part of walking_xyz frames
+  EXPECT_LE(dropped, dyn) << m.dump();
+  const double recall = numberOf(m, "dynamic_recall");
+  EXPECT_NEAR(recall, dropped / dyn, 1e-3) << m.dump();
+  EXPECT_GT(recall, 0.5) << m.dump();
+  const double sib = numberOf(m, "static_in_boxes"), kept = numberOf(m, "kept");
+  EXPECT_GT(sib, 0) << m.dump();
+  EXPECT_LE(kept, sib) << m.dump();
+  const double retention = numberOf(m, "static_retention");
+  EXPECT_NEAR(retention, kept / sib, 1e-3) << m.dump();
   EXPECT_GE(retention, 0.0);
   EXPECT_LE(retention, 1.0);
   // Detection/screening time and keypoint counts of the screening itself.
-  const std::string kp = jsonObject(js, "keypoints");
-  EXPECT_GT(jsonNumberOf(kp, "in_boxes"), 0) << kp;
-  EXPECT_EQ(jsonNumberOf(kp, "in_boxes"), jsonNumberOf(kp, "kept") + jsonNumberOf(kp, "dropped")) << kp;
-  const std::string timings = jsonObject(js, "timings");
-  EXPECT_FALSE(jsonObject(timings, "screening").empty()) << js;
-  EXPECT_FALSE(jsonObject(timings, "detection").empty()) << js;
-  EXPECT_EQ(lineCount(joinPath(out, "CameraTrajectory.txt")), jsonNumberOf(js, "trajectory_poses"));
+  const Json kp = js["keypoints"];
+  EXPECT_GT(numberOf(kp, "in_boxes"), 0) << kp.dump();
+  EXPECT_EQ(numberOf(kp, "in_boxes"), numberOf(kp, "kept") + numberOf(kp, "dropped")) << kp.dump();
+  EXPECT_GT(numberOf(js["timings"]["screening"], "count"), 0) << js.dump();
+  EXPECT_TRUE(js["timings"]["detection"].is_object()) << js.dump();  // no detector ran: count 0
+  EXPECT_EQ(lineCount(joinPath(out, "CameraTrajectory.txt")), numberOf(js, "trajectory_poses"));
 }
 
 // The detector's rows of a boxes_screened.txt (tracked 0), with the header dropped.
@@ -202,8 +188,8 @@ TEST_F(RunnerMetrics, ReplayedBoxesAreTheBoxesOfTheFirstRun) {
       << so << se;
   EXPECT_NE(se.find("boxes: " + replay), std::string::npos) << se;
   EXPECT_EQ(detectedRows(joinPath(second, "boxes_screened.txt")), want);
-  const std::string js = readAll(joinPath(second, "stats.json"));
-  EXPECT_EQ(jsonNumberOf(jsonObject(js, "boxes_screened"), "detected"), static_cast<double>(want.size())) << js;
+  const Json js = statsOf(second);
+  EXPECT_EQ(numberOf(js["boxes_screened"], "detected"), static_cast<double>(want.size())) << js.dump();
 
   // A file in the other format (boxes.txt has no score/tracked columns): the error names it.
   ASSERT_NE(runTool({"--sequence", seq(), "--out", second, "--boxes", joinPath(seq(), "boxes.txt"),
@@ -222,20 +208,26 @@ TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   const std::string out = joinPath(dir_, "out_off");
   std::string so, se;
   ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--dynamic-mode", "off", "--no-vocabulary",
-                     "--max-frames", "10"},
+                     "--max-frames", "10", "--set", "ORBextractor.nFeatures=600"},
                     joinPath(dir_, "off"), so, se),
             0)
       << so << se;
   EXPECT_NE(se.find("vocabulary: none"), std::string::npos) << se;
-  const std::string m = jsonObject(readAll(joinPath(out, "stats.json")), "screening_metrics");
-  EXPECT_EQ(jsonNumberOf(m, "frames"), 10) << m;
-  EXPECT_GT(jsonNumberOf(m, "dynamic_keypoints"), 0) << m;
-  EXPECT_EQ(jsonNumberOf(m, "dropped"), 0) << m;
-  EXPECT_EQ(jsonNumberOf(m, "dynamic_recall"), 0) << m;
-  EXPECT_EQ(jsonNumberOf(m, "static_dropped"), 0) << m;
+  // The overrides and every setting the run read, as it used them.
+  const Json js = statsOf(out);
+  EXPECT_EQ(js["overrides"]["Screening.mode"], "off") << js.dump();
+  EXPECT_EQ(js["settings"]["Screening.mode"], "off") << js.dump();
+  EXPECT_EQ(js["settings"]["ORBextractor.nFeatures"], 600) << js.dump();
+  EXPECT_EQ(js["settings"]["Tracking.minInliers"], 30) << js.dump();  // a default, recorded too
+  const Json m = js["screening_metrics"];
+  EXPECT_EQ(numberOf(m, "frames"), 10) << m.dump();
+  EXPECT_GT(numberOf(m, "dynamic_keypoints"), 0) << m.dump();
+  EXPECT_EQ(numberOf(m, "dropped"), 0) << m.dump();
+  EXPECT_EQ(numberOf(m, "dynamic_recall"), 0) << m.dump();
+  EXPECT_EQ(numberOf(m, "static_dropped"), 0) << m.dump();
   // No box in mode off: retention has no denominator.
-  EXPECT_EQ(jsonNumberOf(m, "static_in_boxes"), 0) << m;
-  EXPECT_NE(m.find("\"static_retention\": null"), std::string::npos) << m;
+  EXPECT_EQ(numberOf(m, "static_in_boxes"), 0) << m.dump();
+  EXPECT_TRUE(m["static_retention"].is_null()) << m.dump();
 }
 
 TEST_F(RunnerMetrics, CorruptMaskWarnsMissingMaskIsSkipped) {
@@ -257,8 +249,8 @@ TEST_F(RunnerMetrics, CorruptMaskWarnsMissingMaskIsSkipped) {
   EXPECT_NE(se.find("warning: "), std::string::npos) << se;
   EXPECT_NE(se.find(masks[2]), std::string::npos) << se;
   EXPECT_EQ(se.find(masks[3]), std::string::npos) << se;
-  const std::string m = jsonObject(readAll(joinPath(out, "stats.json")), "screening_metrics");
-  EXPECT_EQ(jsonNumberOf(m, "frames"), 4) << m;
+  const Json m = statsOf(out)["screening_metrics"];
+  EXPECT_EQ(numberOf(m, "frames"), 4) << m.dump();
 }
 
 TEST_F(RunnerMetrics, BadVocabularyAndConfigAreOneLineErrors) {
@@ -295,12 +287,11 @@ TEST_F(RunnerMetrics, CtrlCWritesTheFramesDoneSoFar) {
   const size_t poses = lineCount(joinPath(out, "CameraTrajectory.txt"));
   EXPECT_GE(poses, 1u) << se;
   EXPECT_LT(poses, static_cast<size_t>(kFrames)) << se;
-  const std::string js = readAll(joinPath(out, "stats.json"));
-  ASSERT_FALSE(js.empty());
-  EXPECT_EQ(js.back(), '\n');
-  EXPECT_NE(js.find("\"interrupted\": true"), std::string::npos) << js;
-  EXPECT_EQ(jsonNumberOf(js, "trajectory_poses"), poses) << js;
-  const double frames = jsonNumberOf(jsonObject(js, "screening_metrics"), "frames");
-  EXPECT_GE(frames, 1) << js;
-  EXPECT_LT(frames, kFrames) << js;
+  const Json js = statsOf(out);
+  ASSERT_TRUE(js.is_object());
+  EXPECT_EQ(js["interrupted"], true) << js.dump();
+  EXPECT_EQ(numberOf(js, "trajectory_poses"), poses) << js.dump();
+  const double frames = numberOf(js["screening_metrics"], "frames");
+  EXPECT_GE(frames, 1) << js.dump();
+  EXPECT_LT(frames, kFrames) << js.dump();
 }

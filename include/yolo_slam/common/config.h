@@ -3,9 +3,13 @@
 // ("%YAML:1.0"), the format of ORB-SLAM2 settings files, so TUM1/2/3.yaml of ORB-SLAM2 users
 // load unchanged. Every module has one options struct with a static `load(const Config&)`
 // that reads its own keys through this class; defaults live in the struct.
+#include "yolo_slam/common/json.h"
+
 #include <opencv2/core/persistence.hpp>
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -38,12 +42,33 @@ class Config {
   // Required variants: a missing key throws yolo_slam::Error naming file and key.
   double requireDouble(const std::string& key) const;
 
+  // Overrides `key` with `value`, a YAML scalar or flow list ("0.5", "detect", "[a, b]"),
+  // before any options are loaded: the runner's --set and the nodelets' ~overrides. Throws
+  // yolo_slam::Error naming the key when the value is not YAML.
+  void set(const std::string& key, const std::string& value);
+  // "Key=value" as given on a command line; throws yolo_slam::Error without a '='.
+  void setFromAssignment(const std::string& assignment);
+  const std::map<std::string, std::string>& overrides() const { return override_text_; }
+
+  // Every key read so far, with the value the getter returned (a default when the key was
+  // absent): the effective options, for stats.json. Shared by copies of this Config.
+  Json effective() const;
+
  private:
   cv::FileNode node(const std::string& key) const;
   [[noreturn]] void fail(const std::string& key, const std::string& why) const;
+  void record(const std::string& key, Json value) const;
 
   std::string path_;
   std::shared_ptr<cv::FileStorage> fs_;
+  // One parsed document per override ("v: <value>"), looked up before fs_.
+  std::map<std::string, std::shared_ptr<cv::FileStorage>> override_fs_;
+  std::map<std::string, std::string> override_text_;
+  struct Record {
+    std::mutex mutex;  // guards values (options may load on several threads)
+    std::map<std::string, Json> values;
+  };
+  std::shared_ptr<Record> record_ = std::make_shared<Record>();
 };
 
 }  // namespace yolo_slam

@@ -1,12 +1,22 @@
 #pragma once
-// Minimal JSON writing helpers (the tools print flat objects and lists; no parser needed).
+// JSON through one library, nlohmann-json (Debian's nlohmann-json3-dev), for writing stats.json
+// and the tools' --json output and for reading them back. Objects keep their members in
+// insertion order, so files read top-down as they were written.
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace yolo_slam {
 
-// Escapes a string for inclusion between double quotes in JSON.
-std::string jsonEscape(const std::string& s);
-// A number formatted for JSON ("null" for NaN/inf).
-std::string jsonNumber(double v, int precision = 6);
+using Json = nlohmann::ordered_json;
+
+// A finite number, or null (JSON has no NaN or infinity).
+Json jsonNumber(double v);
+// num / den, or null without a denominator (nothing to take a share of).
+Json jsonRatio(long num, long den);
+// Two-space indented text with a trailing newline.
+std::string dumpJson(const Json& j);
+// Parses `text`; throws yolo_slam::Error naming `name` and the byte offset when it is not JSON.
+Json parseJson(const std::string& text, const std::string& name);
 
 }  // namespace yolo_slam

@@ -1,5 +1,7 @@
 #pragma once
 // Wall-clock timing and summaries (median / mean / p95) for stats.json and benchmarks.
+#include "yolo_slam/common/json.h"
+
 #include <chrono>
 #include <string>
 #include <vector>
@@ -28,6 +30,6 @@ struct Summary {
 Summary summarize(std::vector<double> values);
 
 // {"count":..,"median_ms":..,"mean_ms":..,"p95_ms":..}
-std::string summaryJsonMs(const Summary& s);
+Json summaryJsonMs(const Summary& s);
 
 }  // namespace yolo_slam

@@ -1,5 +1,6 @@
 #pragma once
 // Output helpers for tools: drawing boxes and JSON.
+#include "yolo_slam/common/json.h"
 #include "yolo_slam/detection/box.h"
 
 #include <opencv2/core.hpp>
@@ -13,7 +14,7 @@ namespace detection {
 void drawBoxes(cv::Mat& image, const Boxes& boxes);
 
 // [{"class":"person","score":0.9,"x1":..,"y1":..,"x2":..,"y2":..}, ...]
-std::string boxesJson(const Boxes& boxes);
+Json boxesJson(const Boxes& boxes);
 
 }  // namespace detection
 }  // namespace yolo_slam

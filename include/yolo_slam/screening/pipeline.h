@@ -17,6 +17,17 @@
 namespace yolo_slam {
 namespace screening {
 
+// Which stages of screening run: decided here once, from the mode and the stage switches,
+// for the pipeline, the runner and the nodelets.
+struct Stages {
+  bool detection = false;          // person boxes are needed: modes detect and detect+geometry
+  bool box_tracking = false;       // Screening.trackBoxes, in a mode with boxes
+  bool label_propagation = false;  // Screening.propagateLabels, in every mode but off
+  bool static_box_veto = false;    // Screening.staticBoxVeto, in every mode but off
+  bool temporal() const { return label_propagation || static_box_veto; }
+};
+Stages stagesFor(const ScreeningOptions& options);
+
 struct PipelineResult {
   detection::Boxes boxes;  // the boxes screened: detections, then tracked boxes (tracked = true)
   ScreeningStats stats;    // of Screener::screen

@@ -5,6 +5,7 @@
 // variant "nearest" takes the nearest sizeable depth cluster instead (people occlude the
 // background). See docs/screening.md for the meaning and units of the paper's nThre = 0.43 and
 // the measurements behind the defaults.
+#include "yolo_slam/common/json.h"
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 
@@ -145,7 +146,10 @@ struct ScreeningStats {
   double ms = 0;       // wall time of screen()
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
   int silhouette = 0;  // of dropped, keypoints the silhouette rule dropped
+  ScreeningStats& operator+=(const ScreeningStats& o);
 };
+// {"in_boxes", "kept", "dropped", "silhouette", "flat_boxes", "iterations"} (ms is timed apart).
+void to_json(Json& j, const ScreeningStats& s);
 
 // The box grown by fraction f of its width/height on each side (Screening.boxDilation).
 cv::Rect2f dilate(const cv::Rect2f& r, double f);
@@ -219,9 +223,12 @@ struct ScreeningMetrics {
   // static_in_boxes_kept / static_in_boxes (1 when there is no static keypoint in a box).
   double staticRetention() const;
   ScreeningMetrics& operator+=(const ScreeningMetrics& o);
-  // {"dynamic_total":..,"dynamic_dropped":..,"dynamic_recall":..,"static_in_boxes":..,...}
-  std::string toJson() const;
 };
+// {"dynamic_keypoints", "dropped", "dynamic_recall", "dynamic_outside_boxes",
+//  "dynamic_outside_dropped", "dynamic_recall_in_boxes", "person_keypoints", "person_dropped",
+//  "person_recall", "static_in_boxes", "kept", "static_retention", "static_keypoints",
+//  "static_dropped", "static_drop_rate"}; a ratio without a denominator is null.
+void to_json(Json& j, const ScreeningMetrics& m);
 
 // Compares a screened frame with a ground-truth mask (CV_8UC1, same size as the image,
 // > 127 = dynamic, 255 = a person; yolo_slam_synth writes 200 for other moving objects, the

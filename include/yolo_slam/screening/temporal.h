@@ -21,6 +21,7 @@
 //
 // Per frame, after Screener::screen:  temporal.apply(frame, boxes, cam);
 #include "yolo_slam/common/camera.h"
+#include "yolo_slam/common/json.h"
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 
@@ -63,16 +64,21 @@ struct TemporalOptions {
   void validate(const std::string& where = "TemporalOptions") const;
 };
 
-// What the last apply() did (for tests, benchmarks and the docs).
+// What apply() did to one frame, or (summed with +=) to a run of frames.
 struct TemporalStats {
-  bool motion_ok = false;       // the camera motion was estimated (else nothing changes)
+  int motion_frames = 0;        // frames whose camera motion was estimated (else nothing changes)
   int motion_inliers = 0;
   int matched = 0;              // keypoints matched to the previous frame
   int static_consistent = 0;    // of those, where a static point would be
   int propagated = 0;           // keypoints marked dynamic by label propagation
   int boxes_vetoed = 0;         // boxes left alone by the static-box veto
   int vetoed = 0;               // screened-dynamic keypoints they kept
+  bool motionOk() const { return motion_frames > 0; }  // of one frame's stats
+  TemporalStats& operator+=(const TemporalStats& o);
 };
+// {"matched", "static_consistent", "motion_frames", "motion_inliers", "propagated",
+//  "boxes_vetoed", "vetoed"}
+void to_json(Json& j, const TemporalStats& s);
 
 // One per camera stream; deterministic. Not thread-safe: the caller serialises frames.
 class TemporalScreening {

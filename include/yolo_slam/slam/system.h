@@ -3,6 +3,7 @@
 // (own thread). The one object driven by the offline runner and the ROS nodelets.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/geometry.h"
+#include "yolo_slam/common/json.h"
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
@@ -42,36 +43,36 @@ struct MapSnapshot {
   std::vector<std::pair<int, int>> covisibility_edges; // indices into keyframes (weight >= 15)
 };
 
-// Counters and timing samples (milliseconds) for stats.json.
+// Boxes screened: from the detector, and carried by the BoxTracker (Screening.trackBoxes).
+struct BoxCounts {
+  long detected = 0, tracked = 0;
+  BoxCounts& operator+=(const BoxCounts& o);
+};
+void to_json(Json& j, const BoxCounts& b);  // {"detected", "tracked"}
+
+// Counters, per-stage stats summed over the frames, and timing samples (milliseconds) for
+// stats.json.
 struct SystemStats {
   size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0, resets = 0;
   size_t keyframes_culled = 0;
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
-  long keypoints_in_boxes = 0, keypoints_kept = 0, keypoints_dropped = 0;
-  long keypoints_propagated = 0;  // marked dynamic by label propagation (propagateLabels)
-  long keypoints_silhouette = 0;  // of keypoints_dropped, by the silhouette rule (silhouetteRadius)
-  long keypoints_vetoed = 0;      // screened dynamic, kept by the static-box veto (staticBoxVeto)
-  long boxes_vetoed = 0;          // boxes the static-box veto left alone
-  // Frame-to-frame evidence (propagateLabels or staticBoxVeto): keypoints matched to the
-  // previous frame, of those static-consistent, frames whose camera motion was estimated.
-  long temporal_matched = 0, temporal_static_consistent = 0, temporal_motion_frames = 0;
-  // Boxes screened: from the detector, and carried by the BoxTracker (Screening.trackBoxes).
-  long boxes_detected = 0, boxes_tracked = 0;
+  screening::ScreeningStats keypoints;  // Screener::screen
+  screening::TemporalStats temporal;    // frame-to-frame evidence (propagateLabels, staticBoxVeto)
+  BoxCounts boxes;
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
 };
 
 // Per frame: extraction_ms + tracking_ms (the tracking thread's share of a frame).
 std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 
-// The stats.json members of System::statsJson, shared with yolo_slam_run's stats.json: JSON
-// members without the enclosing braces, two-space indented, no trailing comma.
-// Counts: frames, tracked, lost, keyframes, keyframes_culled, map_points, map_resets,
-// relocalizations, loops_closed, global_bundle_adjustments, keypoints {...}, temporal {...},
-// boxes_screened {...}.
-std::string statsCountsJson(const SystemStats& s);
-// "timings": median/p95/... (ms) per stage, then `extra` stages measured by the caller.
-std::string statsTimingsJson(const SystemStats& s,
-                             const std::vector<std::pair<std::string, std::vector<double>>>& extra = {});
+// The counts of stats.json, shared by System::statsJson and yolo_slam_run: frames, tracked,
+// lost, keyframes, keyframes_culled, map_points, map_resets, relocalizations, loops_closed,
+// global_bundle_adjustments, keypoints {...}, temporal {...}, boxes_screened {...}.
+Json statsCountsJson(const SystemStats& s);
+// Per stage {"count", "median_ms", "mean_ms", "p95_ms"}: extraction, screening, tracking,
+// extraction_plus_tracking, local_mapping, detection, then `extra` stages measured by the caller.
+Json statsTimingsJson(const SystemStats& s,
+                      const std::vector<std::pair<std::string, std::vector<double>>>& extra = {});
 
 // Everything System reads from the settings file, in one place (tools override fields, e.g. the
 // runner's --dynamic-mode, before constructing the System).
