@@ -25,6 +25,7 @@ DEPENDENCIES='
   eigen:              libeigen3-dev
   libceres-dev:       libceres-dev
   libopenni2-dev:     libopenni2-dev
+  nlohmann-json-dev:  nlohmann-json3-dev
   message_generation: ros-message-generation
   message_runtime:    ros-message-runtime
   roslaunch:          python3-roslaunch rosbash
