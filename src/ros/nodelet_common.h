@@ -5,6 +5,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <sensor_msgs/CameraInfo.h>
 
@@ -17,12 +18,21 @@ namespace yolo_slam {
 namespace ros1 {
 
 // The settings file named by ~settings (ORB-SLAM2-style YAML); "" gives an empty Config, so
-// every module keeps its built-in defaults. Throws yolo_slam::Error naming the file.
+// every module keeps its built-in defaults. ~overrides, a list of "Key=value" strings, is applied
+// on top before anything loads (the runner's --set). Throws yolo_slam::Error naming the file or
+// the override.
 inline Config loadSettings(const ::ros::NodeHandle& pnh, std::string* path_out = nullptr) {
   std::string path;
   pnh.param<std::string>("settings", path, "");
   if (path_out) *path_out = path;
-  return path.empty() ? Config() : Config::fromFile(path);
+  Config cfg = path.empty() ? Config() : Config::fromFile(path);
+  if (!pnh.hasParam("overrides")) return cfg;
+  std::vector<std::string> overrides;
+  if (!pnh.getParam("overrides", overrides))
+    throw Error(pnh.resolveName("overrides") + " must be a list of \"Key=value\" strings, e.g. "
+                "['Screening.boxDilation=0.1']");
+  for (const auto& o : overrides) cfg.setFromAssignment(o);
+  return cfg;
 }
 
 // Camera model from the settings when they hold Camera.fx, else the built-in defaults (the
