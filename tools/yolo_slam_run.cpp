@@ -53,7 +53,7 @@ const char* kUsage =
     "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
-    "                     [--static-box-veto on|off]\n"
+    "                     [--static-box-veto on|off] [--sequential]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -67,7 +67,8 @@ const char* kUsage =
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
     "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
-    "                     LocalMapping.*, Detector.*); default DIR/camera.yaml if it exists\n"
+    "                     LocalMapping.*, LoopClosing.*, System.*, Detector.*); default\n"
+    "                     DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
     "  --dynamic-mode M   override Screening.mode of the config: off, detect, geometry or\n"
@@ -89,6 +90,8 @@ const char* kUsage =
     "                     but off)\n"
     "  --static-box-veto B  override Screening.staticBoxVeto: on keeps the keypoints of a box\n"
     "                     whose dropped keypoints all sit where static points would be\n"
+    "  --sequential       override System.sequential: local mapping and loop closing run after\n"
+    "                     each frame in the main thread, so a run repeats bit for bit (slower)\n"
     "  -h, --help         this text\n";
 
 struct Args {
@@ -96,7 +99,7 @@ struct Args {
       propagate_labels, static_box_veto, boxes_file;
   long max_frames = -1;
   bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
-       single_model = false;
+       single_model = false, sequential = false;
 };
 
 Args parseArgs(int argc, char** argv) {
@@ -116,6 +119,7 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--no-vocabulary") a.no_vocabulary = true;
     else if (s == "--dynamic-mode") a.dynamic_mode = need(i, s);
     else if (s == "--realtime") a.realtime = true;
+    else if (s == "--sequential") a.sequential = true;
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
     else if (s == "--boxes") a.boxes_file = need(i, s);
     else if (s == "--propagate-labels") {
@@ -271,6 +275,7 @@ int run(const Args& args) {
   if (!args.track_boxes.empty()) sys_opt.screening.track_boxes = args.track_boxes == "on";
   if (!args.propagate_labels.empty()) sys_opt.screening.propagate_labels = args.propagate_labels == "on";
   if (!args.static_box_veto.empty()) sys_opt.screening.static_box_veto = args.static_box_veto == "on";
+  if (args.sequential) sys_opt.sequential = true;
   const screening::DynamicMode mode = sys_opt.screening.mode;
   const bool needs_boxes = mode == screening::DynamicMode::Detect || mode == screening::DynamicMode::DetectGeometry;
 
@@ -457,6 +462,7 @@ int run(const Args& args) {
      << (sys_opt.screening.propagate_labels && mode != screening::DynamicMode::Off ? "true" : "false")
      << ",\n  \"static_box_veto\": "
      << (sys_opt.screening.static_box_veto && mode != screening::DynamicMode::Off ? "true" : "false")
+     << ",\n  \"sequential\": " << (sys_opt.sequential ? "true" : "false")
      << ",\n  \"vocabulary\": \"" << jsonEscape(args.vocabulary) << "\""
      << ",\n  \"screening_metrics\": " << metrics.json() << ",\n"
      << slam::statsTimingsJson(s, {{"frame", frame_ms}}) << "\n}\n";
