@@ -236,6 +236,23 @@ TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   // No box in mode off: retention has no denominator.
   EXPECT_EQ(jsonNumberOf(m, "static_in_boxes"), 0) << m;
   EXPECT_NE(m.find("\"static_retention\": null"), std::string::npos) << m;
+  EXPECT_NE(readAll(joinPath(out, "stats.json")).find("\"sequential\": false"), std::string::npos);
+}
+
+TEST_F(RunnerMetrics, SequentialRunsWriteIdenticalTrajectories) {
+  std::string traj[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string out = joinPath(dir_, "out_sequential" + std::to_string(k));
+    std::string so, se;
+    ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential"},
+                      joinPath(dir_, "sequential" + std::to_string(k)), so, se),
+              0)
+        << so << se;
+    EXPECT_NE(readAll(joinPath(out, "stats.json")).find("\"sequential\": true"), std::string::npos);
+    traj[k] = readAll(joinPath(out, "CameraTrajectory.txt"));
+  }
+  EXPECT_FALSE(traj[0].empty());
+  EXPECT_EQ(traj[0], traj[1]);
 }
 
 TEST_F(RunnerMetrics, CorruptMaskWarnsMissingMaskIsSkipped) {
