@@ -90,8 +90,8 @@ const char* kUsage =
     "                     but off)\n"
     "  --static-box-veto B  override Screening.staticBoxVeto: on keeps the keypoints of a box\n"
     "                     whose dropped keypoints all sit where static points would be\n"
-    "  --sequential       override System.sequential: local mapping and loop closing run after\n"
-    "                     each frame in the main thread, so a run repeats bit for bit (slower)\n"
+    "  --sequential       set System.sequential: local mapping and loop closing run after\n"
+    "                     each frame in the main thread, so a run repeats bit for bit\n"
     "  -h, --help         this text\n";
 
 struct Args {

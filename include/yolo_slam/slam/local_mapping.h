@@ -1,8 +1,9 @@
 #pragma once
 // Local mapping (owned by System; own thread, or inline in RunMode::Sequential): processes the
-// keyframes that Tracking inserts through a bounded queue: associates their points, culls recent points, triangulates new
-// points with the best covisible keyframes, fuses duplicates, runs local bundle adjustment
-// (Ceres, aborted when a new keyframe arrives) and culls redundant keyframes.
+// keyframes that Tracking inserts through a bounded queue: associates their points, culls
+// recent points, triangulates new points with the best covisible keyframes, fuses duplicates,
+// runs local bundle adjustment (Ceres, aborted when a new keyframe arrives) and culls
+// redundant keyframes.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/types.h"

@@ -100,9 +100,10 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // Extract + screen + track (sequential: then local mapping and loop closing). `image`: BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F
-  // metres (0/NaN invalid) or empty. Bad input (empty image, wrong depth size/type) is reported
-  // on stderr and the frame is reported lost; never throws for per-frame data problems.
+  // Extract + screen + track (sequential: then local mapping and loop closing). `image`:
+  // BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F metres (0/NaN invalid) or empty. Bad
+  // input (empty image, wrong depth size/type) is reported on stderr and the frame is reported
+  // lost; never throws for per-frame data problems.
   TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                         const detection::Boxes& boxes);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
