@@ -53,7 +53,7 @@ const char* kUsage =
     "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
-    "                     [--static-box-veto on|off] [--set KEY=VALUE ...]\n"
+    "                     [--static-box-veto on|off] [--sequential] [--set KEY=VALUE ...]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -67,7 +67,8 @@ const char* kUsage =
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
     "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
-    "                     LocalMapping.*, Detector.*); default DIR/camera.yaml if it exists\n"
+    "                     LocalMapping.*, LoopClosing.*, System.*, Detector.*); default\n"
+    "                     DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
     "  --set KEY=VALUE    override a settings key (repeatable; YAML value: a number, a word or\n"
@@ -93,6 +94,8 @@ const char* kUsage =
     "                     but off)\n"
     "  --static-box-veto B  --set Screening.staticBoxVeto (on/off): on keeps the keypoints of a box\n"
     "                     whose dropped keypoints all sit where static points would be\n"
+    "  --sequential       --set System.sequential=1: local mapping and loop closing run after\n"
+    "                     each frame in the main thread, so a run repeats bit for bit\n"
     "  -h, --help         this text\n";
 
 struct Args {
@@ -153,6 +156,7 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--set") a.overrides.push_back(need(i, s));
     else if (s == "--dynamic-mode") a.overrides.push_back("Screening.mode=" + need(i, s));
     else if (s == "--realtime") a.realtime = true;
+    else if (s == "--sequential") a.overrides.push_back("System.sequential=1");
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
     else if (s == "--boxes") a.boxes_file = need(i, s);
     else if (s == "--propagate-labels") a.overrides.push_back(onOffOverride(s, "Screening.propagateLabels", need(i, s)));
@@ -485,6 +489,7 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res
   j["track_boxes"] = st.box_tracking;
   j["propagate_labels"] = st.label_propagation;
   j["static_box_veto"] = st.static_box_veto;
+  j["sequential"] = setup.options.sequential;
   j["vocabulary"] = args.vocabulary;
   j["screening_metrics"] = res.metrics.json();
   j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}});

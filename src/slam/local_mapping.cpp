@@ -20,8 +20,8 @@ namespace yolo_slam {
 namespace slam {
 
 LocalMapping::LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
-                           std::shared_ptr<const vocabulary::Vocabulary> vocabulary)
-    : map_(map), cam_(cam), opt_(opt), voc_(std::move(vocabulary)) {
+                           std::shared_ptr<const vocabulary::Vocabulary> vocabulary, RunMode mode)
+    : map_(map), cam_(cam), opt_(opt), voc_(std::move(vocabulary)), mode_(mode) {
   if (opt_.queue_size < 1) opt_.queue_size = 1;
 }
 
@@ -31,7 +31,7 @@ void LocalMapping::start() {
   std::lock_guard<std::mutex> lk(queue_mutex_);
   if (thread_.joinable()) return;
   stop_ = false;
-  thread_ = std::thread([this] { run(); });
+  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] { run(); });
 }
 
 void LocalMapping::stop() {
@@ -136,22 +136,32 @@ void LocalMapping::run() {
       accept_.store(queue_.empty());
       continue;
     }
-    KeyFramePtr kf = queue_.front();
-    queue_.pop_front();
-    busy_ = true;
-    accept_.store(false);
-    lk.unlock();
-    Stopwatch sw;
-    processOne(kf);
-    const double ms = sw.ms();
-    lk.lock();
-    busy_ = false;
-    timings_.push_back(ms);
-    ++processed_;
-    if (queue_.empty()) accept_.store(true);
-    cv_.notify_all();
+    processFront(lk);
   }
   busy_ = false;
+  cv_.notify_all();
+}
+
+void LocalMapping::processQueued() {
+  if (mode_ != RunMode::Sequential) return;
+  std::unique_lock<std::mutex> lk(queue_mutex_);
+  while (!stop_ && !pauseWanted() && !queue_.empty()) processFront(lk);
+}
+
+void LocalMapping::processFront(std::unique_lock<std::mutex>& lk) {
+  KeyFramePtr kf = queue_.front();
+  queue_.pop_front();
+  busy_ = true;
+  accept_.store(false);
+  lk.unlock();
+  Stopwatch sw;
+  processOne(kf);
+  const double ms = sw.ms();
+  lk.lock();
+  busy_ = false;
+  timings_.push_back(ms);
+  ++processed_;
+  if (queue_.empty()) accept_.store(true);
   cv_.notify_all();
 }
 

@@ -25,8 +25,8 @@ namespace yolo_slam {
 namespace slam {
 
 LoopClosing::LoopClosing(Map& map, const CameraModel& cam, const LoopClosingOptions& opt,
-                         LocalMapping* mapper)
-    : map_(map), cam_(cam), opt_(opt), mapper_(mapper) {}
+                         LocalMapping* mapper, RunMode mode)
+    : map_(map), cam_(cam), opt_(opt), mapper_(mapper), mode_(mode) {}
 
 LoopClosing::~LoopClosing() { stop(); }
 
@@ -35,7 +35,7 @@ void LoopClosing::start() {
   if (thread_.joinable()) return;
   stop_ = false;
   running_ = true;
-  thread_ = std::thread([this] { run(); });
+  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] { run(); });
 }
 
 void LoopClosing::stop() {
@@ -59,7 +59,14 @@ void LoopClosing::insertKeyFrame(const KeyFramePtr& kf) {
   cv_.notify_all();
 }
 
+void LoopClosing::processQueued() {
+  if (mode_ != RunMode::Sequential) return;
+  std::unique_lock<std::mutex> lk(queue_mutex_);
+  while (!stop_ && !queue_.empty()) processFront(lk);
+}
+
 void LoopClosing::waitIdle() {
+  if (mode_ == RunMode::Sequential) return;
   while (true) {
     {
       std::unique_lock<std::mutex> lk(queue_mutex_);
@@ -99,15 +106,19 @@ void LoopClosing::run() {
   while (true) {
     cv_.wait(lk, [this] { return stop_ || !queue_.empty(); });
     if (stop_) break;
-    KeyFramePtr kf = queue_.front();
-    queue_.pop_front();
-    busy_ = true;
-    lk.unlock();
-    processOne(kf);
-    lk.lock();
-    busy_ = false;
-    cv_.notify_all();
+    processFront(lk);
   }
+  busy_ = false;
+  cv_.notify_all();
+}
+
+void LoopClosing::processFront(std::unique_lock<std::mutex>& lk) {
+  KeyFramePtr kf = queue_.front();
+  queue_.pop_front();
+  busy_ = true;
+  lk.unlock();
+  processOne(kf);
+  lk.lock();
   busy_ = false;
   cv_.notify_all();
 }
@@ -553,7 +564,8 @@ void LoopClosing::correctLoop(const KeyFramePtr& kf) {
     gba_stop_.store(false);
     gba_running_.store(true);
     const long loop_id = kf->id;
-    gba_thread_ = std::thread([this, loop_id] { runGlobalBA(loop_id); });
+    if (mode_ == RunMode::Sequential) runGlobalBA(loop_id);
+    else gba_thread_ = std::thread([this, loop_id] { runGlobalBA(loop_id); });
   }
 }
 

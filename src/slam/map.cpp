@@ -95,7 +95,7 @@ void Map::eraseKeyFrame(const KeyFramePtr& kf) {
 
   // Re-attach the children (ORB-SLAM2 SetBadFlag): repeatedly pick the child with the strongest
   // covisibility to an already-attached candidate (initially the erased keyframe's parent).
-  std::set<KeyFrame*> candidates;
+  std::set<KeyFrame*, ById> candidates;
   if (kf->parent) candidates.insert(kf->parent.get());
   while (!kf->children.empty()) {
     int best_w = -1;

@@ -29,6 +29,7 @@ SystemOptions SystemOptions::load(const Config& cfg) {
   o.orb = features::OrbOptions::load(cfg);
   o.screening = screening::ScreeningOptions::load(cfg);
   o.slam = SlamOptions::load(cfg);
+  o.sequential = cfg.getBool("System.sequential", o.sequential);
   return o;
 }
 
@@ -38,7 +39,10 @@ System::System(const CameraModel& cam, const Config& cfg,
 
 System::System(const CameraModel& cam, const SystemOptions& options,
                std::shared_ptr<const vocabulary::Vocabulary> vocabulary)
-    : cam_(cam), opt_(options.slam), voc_(std::move(vocabulary)) {
+    : cam_(cam),
+      opt_(options.slam),
+      run_mode_(options.sequential ? RunMode::Sequential : RunMode::Threaded),
+      voc_(std::move(vocabulary)) {
   const features::OrbOptions& orb_opt = options.orb;
   orb_ = std::make_unique<features::OrbExtractor>(orb_opt);
   screening_ = std::make_unique<screening::ScreeningPipeline>(options.screening);
@@ -48,9 +52,9 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     kfdb_ = std::make_unique<vocabulary::KeyFrameDatabase>();
     map_->setKeyFrameDatabase(kfdb_.get());
   }
-  mapper_ = std::make_unique<LocalMapping>(*map_, cam_, opt_.mapping, voc_);
+  mapper_ = std::make_unique<LocalMapping>(*map_, cam_, opt_.mapping, voc_, run_mode_);
   if (voc_ && opt_.loop.enabled) {
-    loop_closer_ = std::make_unique<LoopClosing>(*map_, cam_, opt_.loop, mapper_.get());
+    loop_closer_ = std::make_unique<LoopClosing>(*map_, cam_, opt_.loop, mapper_.get(), run_mode_);
     mapper_->setLoopClosing(loop_closer_.get());
   }
   tracker_ = std::make_unique<Tracking>(cam_, opt_.tracking, *map_, mapper_.get(), voc_, pyr);
@@ -163,8 +167,17 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
   if (reset_requested) {
     std::fprintf(stderr, "warning: frame %.6f: lost for long with a small map; map reset\n", frame.stamp);
     resetInternal(true);
+  } else if (run_mode_ == RunMode::Sequential) {
+    runBackEndInline();
   }
   return res;
+}
+
+void System::runBackEndInline() {
+  // Caller holds track_mutex_ (not update_mutex). Local mapping hands each processed keyframe
+  // to loop closing, so its queue is complete once the mapper's is drained.
+  mapper_->processQueued();
+  if (loop_closer_) loop_closer_->processQueued();
 }
 
 void System::resetInternal(bool keep_trajectory) {

@@ -26,6 +26,7 @@ TEST(SlamLoopClosing, LoopPresetDetectsLoopAndLowersAte) {
 
   slam::SystemOptions opt = slam::SystemOptions::load(Config());
   opt.screening.mode = screening::DynamicMode::Off;
+  opt.sequential = true;  // mapping keeps up with every frame, as at 5 fps in real time
   slam::SystemOptions opt_off = opt;
   opt_off.slam.loop.enabled = false;
   ASSERT_TRUE(opt.slam.loop.enabled);  // the default
@@ -38,12 +39,7 @@ TEST(SlamLoopClosing, LoopPresetDetectsLoopAndLowersAte) {
     gt.push_back({f.rgb_stamp, f.T_wc});
     tracked_on += on.trackRgbd(f.bgr, f.depth, f.rgb_stamp, {}).state == slam::TrackingState::Ok;
     tracked_off += off.trackRgbd(f.bgr, f.depth, f.rgb_stamp, {}).state == slam::TrackingState::Ok;
-    // Let mapping keep up, as it would at 5 fps in real time (and for repeatability).
-    on.waitForLocalMapping();
-    off.waitForLocalMapping();
   }
-  on.waitForLoopClosing();
-  off.waitForLoopClosing();
   const double ate_on = eval::computeAte(gt, on.cameraTrajectory()).stats.rmse;
   const double ate_off = eval::computeAte(gt, off.cameraTrajectory()).stats.rmse;
   const auto loops = on.loops();
@@ -56,4 +52,5 @@ TEST(SlamLoopClosing, LoopPresetDetectsLoopAndLowersAte) {
   EXPECT_EQ(on.stats().loops_closed, loops.size());
   EXPECT_GE(tracked_on, tracked_off);
   EXPECT_LT(ate_on, ate_off);
+  EXPECT_LT(ate_on, 0.011);  // measured (sequential): 7.3 mm, off 14.6 mm
 }

@@ -228,6 +228,25 @@ TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   // No box in mode off: retention has no denominator.
   EXPECT_EQ(numberOf(m, "static_in_boxes"), 0) << m.dump();
   EXPECT_TRUE(m["static_retention"].is_null()) << m.dump();
+  EXPECT_EQ(js["sequential"], false) << js.dump();
+}
+
+TEST_F(RunnerMetrics, SequentialRunsWriteIdenticalTrajectories) {
+  std::string traj[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string out = joinPath(dir_, "out_sequential" + std::to_string(k));
+    std::string so, se;
+    ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential"},
+                      joinPath(dir_, "sequential" + std::to_string(k)), so, se),
+              0)
+        << so << se;
+    const Json js = statsOf(out);
+    EXPECT_EQ(js["sequential"], true) << js.dump();
+    EXPECT_EQ(js["settings"]["System.sequential"], true) << js.dump();
+    traj[k] = readAll(joinPath(out, "CameraTrajectory.txt"));
+  }
+  EXPECT_FALSE(traj[0].empty());
+  EXPECT_EQ(traj[0], traj[1]);
 }
 
 TEST_F(RunnerMetrics, CorruptMaskWarnsMissingMaskIsSkipped) {

@@ -27,7 +27,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // Spanning tree. A child does not own its parent's lifetime link in reverse: children are raw
   // pointers, valid because an erased keyframe removes itself from its parent's children.
   KeyFramePtr parent;
-  std::set<KeyFrame*> children;
+  std::set<KeyFrame*, ById> children;   // by id: deterministic iteration
   bool first_connection = true;
   std::set<KeyFramePtr, ById> loop_edges;          // for loop closing (later issue)
   bool bad = false;

@@ -1,8 +1,9 @@
 #pragma once
-// Local mapping (own thread, owned by System): processes the keyframes that Tracking inserts
-// through a bounded queue: associates their points, culls recent points, triangulates new
-// points with the best covisible keyframes, fuses duplicates, runs local bundle adjustment
-// (Ceres, aborted when a new keyframe arrives) and culls redundant keyframes.
+// Local mapping (owned by System; own thread, or inline in RunMode::Sequential): processes the
+// keyframes that Tracking inserts through a bounded queue: associates their points, culls
+// recent points, triangulates new points with the best covisible keyframes, fuses duplicates,
+// runs local bundle adjustment (Ceres, aborted when a new keyframe arrives) and culls
+// redundant keyframes.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/types.h"
@@ -26,13 +27,18 @@ class LoopClosing;
 class LocalMapping {
  public:
   LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
-               std::shared_ptr<const vocabulary::Vocabulary> vocabulary);
+               std::shared_ptr<const vocabulary::Vocabulary> vocabulary,
+               RunMode mode = RunMode::Threaded);
   ~LocalMapping();
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
 
-  void start();          // spawns the thread (idempotent)
+  void start();          // spawns the thread (idempotent); Sequential: no thread
   void stop();           // finishes the keyframe in progress, joins; queued ones are dropped
+  // Sequential mode: processes every queued keyframe in the caller's thread, as the thread
+  // would (timings, counters, acceptsKeyFrames); returns at once while paused or stopped and
+  // does nothing in Threaded mode. The caller must NOT hold map.update_mutex.
+  void processQueued();
 
   // Called by Tracking (holding map.update_mutex). Returns false if the queue is full.
   bool insertKeyFrame(const KeyFramePtr& kf);
@@ -42,7 +48,8 @@ class LocalMapping {
   void interruptBA() { abort_ba_.store(true); }
 
   // Pausing (localization-only mode, reset): the thread finishes its current keyframe and
-  // waits. waitUntilPaused() blocks until it does. The caller must NOT hold map.update_mutex.
+  // waits (Sequential: processQueued() leaves the queue alone). waitUntilPaused() blocks until
+  // it does (Sequential: returns at once). The caller must NOT hold map.update_mutex.
   void pause();
   void waitUntilPaused();
   void resume();
@@ -53,8 +60,8 @@ class LocalMapping {
   bool paused() const { return pauseWanted(); }
   // Every processed keyframe is handed on (set before start(); may be null).
   void setLoopClosing(LoopClosing* lc) { loop_closer_ = lc; }
-  // Blocks until the queue is empty and the thread is idle (tests, deterministic runs).
-  // The caller must NOT hold map.update_mutex.
+  // Blocks until the queue is empty and the thread is idle, or paused (Sequential: returns at
+  // once). The caller must NOT hold map.update_mutex.
   void waitIdle();
   // Drops queued keyframes and the recent-points list (while paused, for reset).
   void clear();
@@ -64,12 +71,15 @@ class LocalMapping {
   size_t processedKeyFrames() const;
   size_t culledKeyFrames() const;
 
-  // One keyframe's whole processing, synchronous (the thread calls this; tests may too when
-  // the thread is not started).
+  // One keyframe's whole processing, synchronous (the thread and processQueued() call this;
+  // tests may too when the thread is not started).
   void processOne(const KeyFramePtr& kf);
 
  private:
   void run();
+  // Pops the front keyframe and processes it with the bookkeeping around (lk holds
+  // queue_mutex_ on entry and on return, released while processing).
+  void processFront(std::unique_lock<std::mutex>& lk);
   bool pauseWanted() const { return pause_requested_.load() || loop_pause_.load(); }
   void processNewKeyFrame();
   void mapPointCulling();
@@ -82,6 +92,7 @@ class LocalMapping {
   CameraModel cam_;
   LocalMappingOptions opt_;
   std::shared_ptr<const vocabulary::Vocabulary> voc_;
+  const RunMode mode_;
 
   // Guards queue_, busy_, paused_ack_, stop_, timings_, counters. Taken alone or after
   // map.update_mutex (Tracking inserts while holding it), never before it.
@@ -101,7 +112,8 @@ class LocalMapping {
   LoopClosing* loop_closer_ = nullptr;
   std::thread thread_;
 
-  // Mapping-thread state (only touched by the thread running processOne).
+  // Mapping-thread state (only touched by the thread running processOne: the mapping thread,
+  // or in Sequential mode the caller of processQueued).
   KeyFramePtr current_;
   std::list<MapPointPtr> recent_points_;
 };

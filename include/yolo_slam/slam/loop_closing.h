@@ -1,7 +1,7 @@
 #pragma once
-// Loop closing (own thread, owned by System): ORB-SLAM2's LoopClosing for RGB-D, with SE3 in
-// place of Sim3 (depth gives metric scale). LocalMapping hands over every processed keyframe;
-// the thread
+// Loop closing (owned by System; own thread, or inline in RunMode::Sequential): ORB-SLAM2's
+// LoopClosing for RGB-D, with SE3 in place of Sim3 (depth gives metric scale). LocalMapping hands
+// over every processed keyframe; the thread
 //   1. detects loop candidates with the map's KeyFrameDatabase (score above the lowest score of
 //      the keyframe's covisibles, covisible keyframes excluded, the candidate's covisibility
 //      group consistent over `consistency` consecutive keyframes),
@@ -11,7 +11,8 @@
 //      its points onto the loop side, fuses duplicated points, adds the loop edge, optimises
 //      the essential graph (spanning tree + loop edges + covisibility >= covisibility_weight),
 //   4. runs global bundle adjustment in a separate thread (aborted by a new loop, reset or
-//      shutdown) and writes it back, propagating to keyframes created meanwhile via the tree.
+//      shutdown; Sequential: synchronously, to the end) and writes it back, propagating to
+//      keyframes created meanwhile via the tree.
 //
 // LOCKING. Map::update_mutex guards every map object (map.h). This class takes it for the
 // detection, the verification and the whole correction, and for the GBA copy/write-back;
@@ -42,23 +43,29 @@ class LocalMapping;
 class LoopClosing {
  public:
   // `mapper` (may be null in tests) is paused during a correction.
-  LoopClosing(Map& map, const CameraModel& cam, const LoopClosingOptions& opt, LocalMapping* mapper);
+  LoopClosing(Map& map, const CameraModel& cam, const LoopClosingOptions& opt, LocalMapping* mapper,
+              RunMode mode = RunMode::Threaded);
   ~LoopClosing();
   LoopClosing(const LoopClosing&) = delete;
   LoopClosing& operator=(const LoopClosing&) = delete;
 
-  void start();   // spawns the thread (idempotent)
+  void start();   // spawns the thread (idempotent); Sequential: accepts keyframes, no thread
   // Stops the thread and any global BA (aborted, not written back); queued keyframes dropped.
   void stop();
   // Called by LocalMapping after a keyframe is processed (no map lock held).
   void insertKeyFrame(const KeyFramePtr& kf);
-  // Blocks until the queue is empty, no keyframe is processed and no global BA runs.
+  // Sequential mode: processes every queued keyframe (and the global BA a loop triggers) in the
+  // caller's thread; does nothing in Threaded mode. The caller must NOT hold map.update_mutex.
+  void processQueued();
+  // Blocks until the queue is empty, no keyframe is processed and no global BA runs
+  // (Sequential: returns at once, nothing runs in the background).
   void waitIdle();
   // Forgets queued keyframes and the consistency groups (map reset; thread stopped).
   void clear();
 
-  // One keyframe's detection + verification + correction, synchronous (the thread calls this;
-  // tests may call it with the thread not started). Returns true if a loop was closed.
+  // One keyframe's detection + verification + correction, synchronous (the thread and
+  // processQueued() call this; tests may call it with the thread not started). Returns true if
+  // a loop was closed.
   bool processOne(const KeyFramePtr& kf);
 
   size_t loopsClosed() const;
@@ -72,6 +79,9 @@ class LoopClosing {
     int count = 0;
   };
   void run();
+  // Pops the front keyframe and processes it (lk holds queue_mutex_ on entry and on return,
+  // released while processing).
+  void processFront(std::unique_lock<std::mutex>& lk);
   std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);   // caller holds update_mutex
   bool computeSE3(const KeyFramePtr& kf, const std::vector<KeyFramePtr>& cands);  // idem
   void correctLoop(const KeyFramePtr& kf);                         // takes update_mutex
@@ -82,6 +92,7 @@ class LoopClosing {
   CameraModel cam_;
   LoopClosingOptions opt_;
   LocalMapping* mapper_;
+  const RunMode mode_;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;
@@ -93,13 +104,14 @@ class LoopClosing {
   std::vector<std::pair<long, long>> loops_;
   std::thread thread_;
 
-  // Global BA thread: started by the loop thread only, joined by it (before a new correction)
-  // or by stop(). gba_running_ is read by waitIdle.
+  // Global BA thread (Threaded mode only): started by the loop thread only, joined by it
+  // (before a new correction) or by stop(). gba_running_ is read by waitIdle.
   std::thread gba_thread_;
   std::atomic<bool> gba_stop_{false};
   std::atomic<bool> gba_running_{false};
 
-  // Loop-thread state (only touched by the thread running processOne).
+  // Loop-thread state (only touched by the thread running processOne: the loop thread, or in
+  // Sequential mode the caller of processQueued).
   std::vector<ConsistentGroup> groups_;
   long last_loop_kf_id_ = -1;
   KeyFramePtr matched_kf_;

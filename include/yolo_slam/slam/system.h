@@ -1,6 +1,7 @@
 #pragma once
-// The SLAM system: wires extraction, screening, tracking (caller's thread) and local mapping
-// (own thread). The one object driven by the offline runner and the ROS nodelets.
+// The SLAM system: wires extraction, screening, tracking (caller's thread), local mapping and
+// loop closing (own threads, or with System.sequential inline after each frame: deterministic).
+// The one object driven by the offline runner and the ROS nodelets.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/geometry.h"
 #include "yolo_slam/common/json.h"
@@ -11,6 +12,7 @@
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
+#include "yolo_slam/slam/types.h"
 
 #include <opencv2/core.hpp>
 
@@ -80,13 +82,17 @@ struct SystemOptions {
   features::OrbOptions orb;              // ORBextractor.*
   screening::ScreeningOptions screening; // Screening.*
   SlamOptions slam;                      // Tracking.*, LocalMapping.*, LoopClosing.*
+  // System.sequential: local mapping, loop closing and the global BA after a loop run in the
+  // caller's thread right after each tracked frame, not in their own threads, so identical
+  // input gives bit-identical output (slower: the caller waits for the back end).
+  bool sequential = false;
   static SystemOptions load(const Config& cfg);
 };
 
 class System {
  public:
-  // Reads the ORBextractor.*, Screening.*, Tracking.* and LocalMapping.* keys of `cfg` (throws
-  // yolo_slam::Error naming the file and key on bad values) and starts the mapping thread.
+  // Reads the keys of SystemOptions from `cfg` (throws yolo_slam::Error naming the file and key
+  // on bad values) and starts the mapping and loop-closing threads (none when sequential).
   System(const CameraModel& cam, const Config& cfg,
          std::shared_ptr<const vocabulary::Vocabulary> vocabulary /* may be null: no BoW */);
   System(const CameraModel& cam, const SystemOptions& options,
@@ -95,9 +101,10 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // Extract + screen + track. `image`: BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F
-  // metres (0/NaN invalid) or empty. Bad input (empty image, wrong depth size/type) is reported
-  // on stderr and the frame is reported lost; never throws for per-frame data problems.
+  // Extract + screen + track (sequential: then local mapping and loop closing). `image`:
+  // BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F metres (0/NaN invalid) or empty. Bad
+  // input (empty image, wrong depth size/type) is reported on stderr and the frame is reported
+  // lost; never throws for per-frame data problems.
   TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                         const detection::Boxes& boxes);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
@@ -107,7 +114,9 @@ class System {
   void setLocalizationOnly(bool on);
   bool localizationOnly() const;
   // Finishes queued keyframes, a pending loop correction and a running global BA, then stops
-  // and joins the mapping and loop-closing threads; idempotent.
+  // and joins the mapping and loop-closing threads; idempotent. (Sequential: nothing is left
+  // pending between frames but keyframes queued while local mapping is paused, dropped here as
+  // in threaded mode.)
   void shutdown();
 
   Trajectory cameraTrajectory() const;    // every tracked frame, T_wc
@@ -117,7 +126,8 @@ class System {
   SystemStats stats() const;
 
   // Extra API for tools and tests.
-  // Blocks until local mapping has processed every queued keyframe.
+  // Blocks until local mapping has processed every queued keyframe (or is paused). Sequential:
+  // returns at once, trackRgbd/trackFeatures have done it.
   void waitForLocalMapping();
   // Timing of the detector, measured by the caller that runs it (reported in the stats).
   void recordDetectionTime(double ms);
@@ -131,15 +141,20 @@ class System {
   // carried by the BoxTracker (tracked = true); use them for screening metrics.
   detection::Boxes lastBoxes() const;
   // Blocks until loop closing has processed its queue and any global BA has finished.
+  // Sequential: returns at once, as waitForLocalMapping.
   void waitForLoopClosing();
+  bool sequential() const { return run_mode_ == RunMode::Sequential; }
   // (current keyframe id, loop keyframe id) of each loop closed so far.
   std::vector<std::pair<long, long>> loops() const;
 
  private:
   void resetInternal(bool keep_trajectory);
+  // Sequential mode: local mapping, then loop closing, on what the last frame queued.
+  void runBackEndInline();
 
   CameraModel cam_;
   SlamOptions opt_;
+  const RunMode run_mode_;
   std::unique_ptr<features::OrbExtractor> orb_;
   // Box tracking, Algorithm 1 and label propagation; stateful between frames.
   std::unique_ptr<screening::ScreeningPipeline> screening_;
@@ -154,7 +169,9 @@ class System {
   std::unique_ptr<Tracking> tracker_;
 
   // Serialises the tracking entry points (trackRgbd/trackFeatures/reset/setLocalizationOnly)
-  // against each other. Lock order: track_mutex_, then map->update_mutex, then stats_mutex_.
+  // against each other; in sequential mode also the local mapping and loop closing they run
+  // (held around runBackEndInline, which takes map->update_mutex only inside).
+  // Lock order: track_mutex_, then map->update_mutex, then stats_mutex_.
   mutable std::mutex track_mutex_;
   // Guards stats_ (taken last, alone or after the mutexes above).
   mutable std::mutex stats_mutex_;

@@ -29,7 +29,12 @@ struct BowData {
 // node size: ~100 nodes).
 constexpr int kBowLevelsUp = 2;
 
-// Orders shared pointers by object id so that iteration order (and so every result) is
+// How LocalMapping and LoopClosing run (System.sequential): each in its own thread, or inline,
+// in the thread of the caller that drains their queues (System, after each tracked frame), so
+// that identical input gives bit-identical results.
+enum class RunMode { Threaded, Sequential };
+
+// Orders (shared or raw) pointers by object id so that iteration order (and so every result) is
 // deterministic, not dependent on heap addresses.
 struct ById {
   template <class P>
