@@ -21,11 +21,8 @@
 #include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
-#include "yolo_slam/features/frame_builder.h"
-#include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/ros/conversions.h"
-#include "yolo_slam/screening/pipeline.h"
-#include "yolo_slam/screening/screener.h"
 
 namespace yolo_slam {
 namespace ros1 {
@@ -52,15 +49,14 @@ class ScreeningNodelet : public nodelet::Nodelet {
     try {
       const Config cfg = loadSettings(pnh);
       camera_.configure(baseCamera(cfg), use_camera_info_);
-      orb_ = std::make_unique<features::OrbExtractor>(features::OrbOptions::load(cfg));
       screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
       std::string mode;
       if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
       if (!use_boxes_) sopt.track_boxes = false;
-      screening_ = std::make_unique<screening::ScreeningPipeline>(sopt);
+      front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
-                   orb_->options().n_features, screening::toString(sopt.mode).c_str(),
+                   front_end_->extractor().options().n_features, screening::toString(sopt.mode).c_str(),
                    use_boxes_ ? "rgb+depth+boxes" : "rgb+depth (no detector)", queue_size);
     } catch (const std::exception& e) {
       NODELET_ERROR("Screening: bad settings: %s. The nodelet is idle until restarted with "
@@ -150,16 +146,15 @@ class ScreeningNodelet : public nodelet::Nodelet {
                     std::to_string(image.rows) + " differs from the calibration (" +
                     std::to_string(cam.width) + "x" + std::to_string(cam.height) + ")");
       cam.rgb_order = is_rgb;
-      features::FeatureFrame frame =
-          features::buildFeatureFrame(*orb_, cam, image, depth_m, rgb->header.stamp.toSec());
       detection::Boxes boxes;
       if (boxes_msg) boxes = boxesFromMsg(boxes_msg->boxes);
-      boxes = screening_->process(frame, boxes, cam, depth_m).boxes;  // + boxes carried by the tracker
+      const frontend::FrontEndResult fe =
+          front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes, cam);
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;
       out->index = static_cast<uint32_t>(++index_);
-      toMsg(frame, boxes, *out);
+      toMsg(fe.frame, fe.boxes, *out);  // the boxes screened: detections and carried ones
       pub_.publish(out);
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++published_;
@@ -212,10 +207,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
   bool use_boxes_ = true, use_camera_info_ = true;
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
-  std::unique_ptr<features::OrbExtractor> orb_;    // const after onInit (thread-safe extract)
-  // Box tracking, Algorithm 1, label propagation: stateful, used by the frame callback only
-  // (the synchroniser serialises it, like index_).
-  std::unique_ptr<screening::ScreeningPipeline> screening_;
+  // Extraction and screening (stateful between frames; used by the frame callback only, which
+  // the synchroniser serialises, like index_).
+  std::unique_ptr<frontend::FrontEnd> front_end_;
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 

@@ -4,9 +4,6 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/json.h"
 #include "yolo_slam/common/timing.h"
-#include "yolo_slam/features/frame_builder.h"
-#include "yolo_slam/features/orb_extractor.h"
-#include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/local_mapping.h"
 #include "yolo_slam/slam/loop_closing.h"
@@ -15,7 +12,6 @@
 #include "yolo_slam/slam/tracking.h"
 #include "yolo_slam/vocabulary/keyframe_database.h"
 
-#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -42,10 +38,13 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     : cam_(cam),
       opt_(options.slam),
       run_mode_(options.sequential ? RunMode::Sequential : RunMode::Threaded),
+      orb_options_(options.orb),
+      screening_options_(options.screening),
       voc_(std::move(vocabulary)) {
   const features::OrbOptions& orb_opt = options.orb;
-  orb_ = std::make_unique<features::OrbExtractor>(orb_opt);
-  screening_ = std::make_unique<screening::ScreeningPipeline>(options.screening);
+  // Checked here, not at the first frame: the front end is made lazily.
+  orb_opt.validate();
+  screening_options_.validate("Screening");
   auto pyr = std::make_shared<ScalePyramid>(ScalePyramid::make(orb_opt.n_levels, orb_opt.scale_factor));
   map_ = std::make_unique<Map>();
   if (voc_) {
@@ -80,68 +79,46 @@ void System::shutdown() {
 }
 
 namespace {
-bool validDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
-  if (depth.empty()) return false;
-  if (depth.type() != CV_32FC1 || depth.size() != image.size()) {
-    std::fprintf(stderr, "warning: frame %.6f: depth image %dx%d type %d does not match the %dx%d "
-                 "colour image (need CV_32FC1 metres); frame tracked without depth\n",
-                 stamp, depth.cols, depth.rows, depth.type(), image.cols, image.rows);
-    return false;
-  }
-  return true;
+// System's policy for a depth image that does not fit: warn and track without depth.
+cv::Mat usableDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
+  if (depth.empty() || image.empty()) return cv::Mat();
+  if (depth.type() == CV_32FC1 && depth.size() == image.size()) return depth;
+  std::fprintf(stderr, "warning: frame %.6f: depth image %dx%d type %d does not match the %dx%d "
+               "colour image (need CV_32FC1 metres); frame tracked without depth\n",
+               stamp, depth.cols, depth.rows, depth.type(), image.cols, image.rows);
+  return cv::Mat();
 }
 }  // namespace
 
 TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                               const detection::Boxes& boxes) {
-  if (image.empty()) {
-    std::fprintf(stderr, "warning: frame %.6f: empty image; frame reported lost\n", stamp);
-    features::FeatureFrame empty;
-    empty.stamp = stamp;
-    return trackFeatures(empty);
-  }
-  cv::Mat depth;
-  if (validDepth(depth_m, image, stamp)) {
-    depth = depth_m.clone();
-    cv::patchNaNs(depth, 0.0);  // NaN = invalid
-    cv::Mat bad = (depth != depth) | (depth == std::numeric_limits<float>::infinity());
-    depth.setTo(0.f, bad);
-  }
-  features::FeatureFrame ff;
-  Stopwatch sw;
+  std::call_once(front_end_once_, [this] {
+    front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
+  });
+  frontend::FrontEndResult fe;
   try {
-    ff = features::buildFeatureFrame(*orb_, cam_, image, depth, stamp);
+    fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_);
   } catch (const Error& e) {
     std::fprintf(stderr, "warning: frame %.6f: %s; frame reported lost\n", stamp, e.what());
-    ff = features::FeatureFrame();
-    ff.stamp = stamp;
+    fe = frontend::FrontEndResult();
+    fe.frame.stamp = stamp;
   }
-  const double extraction_ms = sw.ms();
-  sw.restart();
-  screening::PipelineResult screened;
-  {
-    std::lock_guard<std::mutex> lk(screening_mutex_);
-    screened = screening_->process(ff, boxes, cam_, depth);
-  }
-  const screening::ScreeningStats& ss = screened.stats;
-  detection::Boxes& used = screened.boxes;
-  const double screening_ms = sw.ms();
   BoxCounts box_counts;
-  for (const auto& b : used) ++(b.tracked ? box_counts.tracked : box_counts.detected);
+  for (const auto& b : fe.boxes) ++(b.tracked ? box_counts.tracked : box_counts.detected);
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
-    stats_.extraction_ms.push_back(extraction_ms);
-    stats_.screening_ms.push_back(screening_ms);
-    stats_.keypoints += ss;
-    stats_.temporal += screened.temporal;
+    stats_.extraction_ms.push_back(fe.stats.extraction_ms);
+    stats_.screening_ms.push_back(fe.stats.screening_ms);
+    stats_.keypoints += fe.stats.screening;
+    stats_.temporal += fe.stats.temporal;
     stats_.boxes += box_counts;
   }
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
-    last_frame_ = ff;
-    last_boxes_ = std::move(used);
+    last_frame_ = fe.frame;
+    last_boxes_ = std::move(fe.boxes);
   }
-  return trackFeatures(ff);
+  return trackFeatures(fe.frame);
 }
 
 TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
@@ -260,8 +237,6 @@ void System::recordDetectionTime(double ms) {
   stats_.detection_ms.push_back(ms);
 }
 
-const features::OrbExtractor& System::extractor() const { return *orb_; }
-const screening::Screener& System::screener() const { return screening_->screener(); }
 
 Trajectory System::cameraTrajectory() const {
   std::lock_guard<std::mutex> tl(track_mutex_);

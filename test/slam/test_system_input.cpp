@@ -2,11 +2,13 @@
 // mismatched depth, empty images, timestamp jumps. Tracking reports lost (or not initialised),
 // never crashes and never outputs a non-finite pose.
 #include "yolo_slam/common/config.h"
+#include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/slam/system.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -122,4 +124,28 @@ TEST(SlamSystem, ResetAndLocalizationMode) {
     EXPECT_TRUE(js.contains(key)) << key << " missing in " << text;
   EXPECT_EQ(js["timings"]["extraction_plus_tracking"]["count"], 7) << text;
   EXPECT_EQ(js["keypoints"]["in_boxes"], 0) << text;
+}
+
+TEST(SlamSystem, TrackRgbdScreensThroughTheFrontEnd) {
+  // The runner (System::trackRgbd) and the Screening nodelet (FrontEnd) screen a frame alike.
+  const SystemOptions opt = SystemOptions::load(Config());
+  System sys(CameraModel(), opt, nullptr);
+  frontend::FrontEnd fe(opt.orb, opt.screening);
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(3.0f));
+  const cv::Rect person(250, 100, 140, 320);
+  depth(person).setTo(1.3f);
+  depth.at<float>(10, 10) = std::numeric_limits<float>::quiet_NaN();
+  detection::Box box;
+  box.rect = cv::Rect2f(person);
+  box.score = 0.9f;
+  for (int k = 0; k < 3; ++k) {
+    const cv::Mat img = texture(10 + k);
+    sys.trackRgbd(img, depth, k / 30.0, {box});
+    const features::FeatureFrame a = sys.lastFrame();
+    const features::FeatureFrame b = fe.process(img, depth, k / 30.0, {box}, CameraModel()).frame;
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(a.dynamic, b.dynamic) << "frame " << k;
+    EXPECT_EQ(a.depth, b.depth) << "frame " << k;
+    EXPECT_GT(std::count(a.dynamic.begin(), a.dynamic.end(), 1), 10) << "frame " << k;
+  }
 }

@@ -8,7 +8,7 @@
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
-#include "yolo_slam/screening/pipeline.h"
+#include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
@@ -131,8 +131,6 @@ class System {
   void waitForLocalMapping();
   // Timing of the detector, measured by the caller that runs it (reported in the stats).
   void recordDetectionTime(double ms);
-  const features::OrbExtractor& extractor() const;
-  const screening::Screener& screener() const;
   TrackingState state() const;
   // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
   // screener), e.g. for screening metrics against ground truth; empty before the first frame.
@@ -155,11 +153,12 @@ class System {
   CameraModel cam_;
   SlamOptions opt_;
   const RunMode run_mode_;
-  std::unique_ptr<features::OrbExtractor> orb_;
-  // Box tracking, Algorithm 1 and label propagation; stateful between frames.
-  std::unique_ptr<screening::ScreeningPipeline> screening_;
-  // Guards screening_ for the whole of one frame's process() (taken alone).
-  std::mutex screening_mutex_;
+  features::OrbOptions orb_options_;
+  screening::ScreeningOptions screening_options_;
+  // Made by the first trackRgbd (trackFeatures callers, the ROS Slam nodelet, screen frames
+  // elsewhere and never need one); serialises its own frames.
+  std::once_flag front_end_once_;
+  std::unique_ptr<frontend::FrontEnd> front_end_;
   std::shared_ptr<const vocabulary::Vocabulary> voc_;
   // Declared before map_: the map removes keyframes from it until destroyed.
   std::unique_ptr<vocabulary::KeyFrameDatabase> kfdb_;

@@ -1,0 +1,61 @@
+#pragma once
+// The frame front end: one RGB-D pair and the person boxes of a frame in, a screened
+// FeatureFrame out. Depth cleaning (io::decodeDepth), ORB extraction
+// (features::buildFeatureFrame) and screening (screening::ScreeningPipeline: box tracking,
+// Algorithm 1, frame-to-frame evidence). The one front end of slam::System::trackRgbd (the
+// offline runner) and the ROS Screening nodelet, so both screen a frame identically.
+#include "yolo_slam/common/camera.h"
+#include "yolo_slam/detection/box.h"
+#include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/features/orb_extractor.h"
+#include "yolo_slam/screening/pipeline.h"
+#include "yolo_slam/screening/screener.h"
+#include "yolo_slam/screening/temporal.h"
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <mutex>
+
+namespace yolo_slam {
+namespace frontend {
+
+struct FrontEndStats {
+  screening::ScreeningStats screening;  // Screener::screen
+  screening::TemporalStats temporal;    // frame-to-frame evidence (zeros when it is off)
+  double extraction_ms = 0, screening_ms = 0;
+};
+
+struct FrontEndResult {
+  features::FeatureFrame frame;  // keypoints, depth, and the dynamic flags screening set
+  detection::Boxes boxes;        // the boxes screened: detections, then carried ones (tracked)
+  FrontEndStats stats;
+};
+
+// One per camera stream: screening remembers tracked boxes and the previous frame.
+class FrontEnd {
+ public:
+  // Validates both (throws yolo_slam::Error naming the bad value).
+  FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOptions& screening);
+
+  // image: BGR/RGB per cam.rgb_order, or gray. depth_m: CV_32F metres registered to the image
+  // (NaN, inf and values <= 0 are invalid), or empty for no depth. Throws yolo_slam::Error
+  // when the image is empty or of an unsupported type, or the depth is of another type or
+  // size than the image. Safe to call from several threads: frames are processed one at a time.
+  FrontEndResult process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                         const detection::Boxes& boxes, const CameraModel& cam);
+  // Forgets tracked boxes and the previous frame (a new sequence or a map reset).
+  void clear();
+
+  const features::OrbExtractor& extractor() const { return *orb_; }
+  const screening::Screener& screener() const { return screening_->screener(); }
+
+ private:
+  std::unique_ptr<features::OrbExtractor> orb_;  // const after construction (thread-safe)
+  // Guards screening_ for one frame's whole process(); taken alone.
+  std::mutex mutex_;
+  std::unique_ptr<screening::ScreeningPipeline> screening_;
+};
+
+}  // namespace frontend
+}  // namespace yolo_slam

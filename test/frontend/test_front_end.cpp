@@ -1,0 +1,115 @@
+// The frame front end: depth cleaning, extraction and screening of one RGB-D pair with boxes.
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/frontend/front_end.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <limits>
+
+using namespace yolo_slam;
+
+namespace {
+
+cv::Mat texture(unsigned seed) {
+  cv::Mat img(480, 640, CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(img, img, cv::Size(5, 5), 1.5);
+  return img;
+}
+
+// A wall 3 m away with a "person" 1.2 m away in the box region.
+const cv::Rect kPerson(260, 120, 120, 300);
+
+cv::Mat wallWithPerson() {
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(3.0f));
+  depth(kPerson).setTo(1.2f);
+  return depth;
+}
+
+detection::Box personBox() {
+  detection::Box b;
+  b.rect = cv::Rect2f(kPerson.x, kPerson.y, kPerson.width, kPerson.height);
+  b.score = 0.9f;
+  b.label = "person";
+  return b;
+}
+
+frontend::FrontEnd makeFrontEnd(screening::DynamicMode mode) {
+  screening::ScreeningOptions s;
+  s.mode = mode;
+  return frontend::FrontEnd(features::OrbOptions(), s);
+}
+
+}  // namespace
+
+TEST(FrontEnd, ScreensThePersonInItsBoxAndKeepsTheWall) {
+  frontend::FrontEnd fe = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  const frontend::FrontEndResult r = fe.process(texture(1), wallWithPerson(), 0.0, {personBox()}, CameraModel());
+  ASSERT_GT(r.frame.size(), 200u);
+  ASSERT_EQ(r.frame.dynamic.size(), r.frame.size());
+  int person = 0, person_dropped = 0, wall_dropped = 0;
+  for (size_t i = 0; i < r.frame.size(); ++i) {
+    const bool on_person = kPerson.contains(r.frame.keypoints[i].pt);
+    person += on_person;
+    person_dropped += on_person && r.frame.dynamic[i];
+    wall_dropped += !on_person && r.frame.dynamic[i];
+  }
+  EXPECT_GT(person, 20);
+  EXPECT_GT(person_dropped, person * 9 / 10);
+  EXPECT_LT(wall_dropped, static_cast<int>(r.frame.size()) / 20);
+  EXPECT_EQ(r.stats.screening.dropped, person_dropped + wall_dropped);
+  ASSERT_EQ(r.boxes.size(), 1u);
+  EXPECT_GT(r.stats.extraction_ms, 0.0);
+}
+
+TEST(FrontEnd, InvalidDepthReadingsAreNoDepth) {
+  frontend::FrontEnd fe = makeFrontEnd(screening::DynamicMode::Off);
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.0f));
+  depth.colRange(0, 320).setTo(std::numeric_limits<float>::quiet_NaN());
+  depth.rowRange(0, 240).colRange(320, 640).setTo(std::numeric_limits<float>::infinity());
+  depth.rowRange(240, 480).colRange(320, 480).setTo(-1.0f);
+  const frontend::FrontEndResult r = fe.process(texture(2), depth, 0.0, {}, CameraModel());
+  ASSERT_GT(r.frame.size(), 200u);
+  int with_depth = 0;
+  for (size_t i = 0; i < r.frame.size(); ++i) {
+    const cv::Point px(cvRound(r.frame.keypoints[i].pt.x), cvRound(r.frame.keypoints[i].pt.y));
+    const float raw = depth.at<float>(px);
+    const float d = r.frame.depth[i];
+    EXPECT_TRUE(std::isfinite(d));
+    if (std::isfinite(raw) && raw > 0) EXPECT_FLOAT_EQ(d, raw);
+    else EXPECT_LE(d, 0.0f) << "keypoint at " << px << " read the invalid reading " << raw << " as " << d;
+    with_depth += d > 0;
+  }
+  EXPECT_GT(with_depth, 0);
+  // The caller's depth image is not modified.
+  EXPECT_TRUE(std::isnan(depth.at<float>(0, 0)));
+}
+
+TEST(FrontEnd, BadInputIsAnError) {
+  frontend::FrontEnd fe = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  EXPECT_THROW(fe.process(cv::Mat(), cv::Mat(), 0.0, {}, CameraModel()), Error);
+  const cv::Mat wrong_type(480, 640, CV_16UC1, cv::Scalar(2000));
+  EXPECT_THROW(fe.process(texture(3), wrong_type, 0.0, {}, CameraModel()), Error);
+  const cv::Mat wrong_size(240, 320, CV_32F, cv::Scalar(2.0f));
+  try {
+    fe.process(texture(3), wrong_size, 1.5, {}, CameraModel());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("320x240"), std::string::npos) << e.what();
+  }
+  // No depth at all is allowed: every keypoint without depth.
+  const frontend::FrontEndResult r = fe.process(texture(3), cv::Mat(), 2.0, {}, CameraModel());
+  EXPECT_GT(r.frame.size(), 200u);
+}
+
+TEST(FrontEnd, BadOptionsAreRejectedAtConstruction) {
+  screening::ScreeningOptions s;
+  s.probability = 2.0;
+  EXPECT_THROW(frontend::FrontEnd(features::OrbOptions(), s), Error);
+  features::OrbOptions o;
+  o.n_features = 0;
+  EXPECT_THROW(frontend::FrontEnd(o, screening::ScreeningOptions()), Error);
+}
