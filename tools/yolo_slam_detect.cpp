@@ -11,6 +11,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -53,79 +54,116 @@ float parseFloat(const std::string& flag, const std::string& v) {
   return f;
 }
 
-int run(int argc, char** argv) {
+struct DetectArgs {
   detection::DetectorOptions opt;
-  bool json = false, extra_given = false, single = false;
+  bool json = false, extra_given = false, single = false, help = false;
   std::string draw, draw_dir;
   std::vector<std::string> images;
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
+};
+
+// OpenCV's thread pool is sized once per process; beyond this it only costs memory.
+constexpr int kMaxThreads = 64;
+
+std::vector<std::string> splitCommas(const std::string& v) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= v.size()) {
+    const size_t comma = v.find(',', start);
+    const std::string c = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!c.empty()) out.push_back(c);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+// One option (with its value, read through `value`); false if `a` is not an option.
+bool parseOption(const std::string& a, const std::function<std::string()>& value, DetectArgs& d) {
+  detection::DetectorOptions& opt = d.opt;
+  if (a == "-h" || a == "--help") {
+    d.help = true;
+  } else if (a == "--model") {
+    opt.model = value();
+  } else if (a == "--extra-model") {
+    if (d.single) throw Error("--single-model and --extra-model exclude each other");
+    if (!d.extra_given) opt.extra_models.clear();
+    d.extra_given = true;
+    opt.extra_models.push_back(value());
+  } else if (a == "--single-model") {
+    if (d.extra_given) throw Error("--single-model and --extra-model exclude each other");
+    d.single = true;
+    opt.extra_models.clear();
+  } else if (a == "--json") {
+    d.json = true;
+  } else if (a == "--draw") {
+    d.draw = value();
+  } else if (a == "--draw-dir") {
+    d.draw_dir = value();
+  } else if (a == "--conf") {
+    opt.conf_threshold = parseFloat(a, value());
+  } else if (a == "--nms") {
+    opt.nms_threshold = parseFloat(a, value());
+  } else if (a == "--threads") {
+    const float t = parseFloat(a, value());
+    if (!(t >= 1 && t <= kMaxThreads)) throw Error("--threads must be in [1, " + std::to_string(kMaxThreads) + "]");
+    opt.threads = int(t);
+  } else if (a == "--no-letterbox") {
+    opt.letterbox = false;
+  } else if (a == "--size") {
+    const std::string v = value();
+    if (std::sscanf(v.c_str(), "%dx%d", &opt.input_width, &opt.input_height) != 2)
+      throw Error("--size needs WxH, e.g. 416x416, got '" + v + "'");
+  } else if (a == "--classes") {
+    opt.dynamic_classes = splitCommas(value());
+  } else {
+    return false;
+  }
+  return true;
+}
+
+DetectArgs parseArgs(int argc, char** argv) {
+  DetectArgs d;
+  for (int i = 1; i < argc && !d.help; ++i) {
+    const std::string a = argv[i];
     auto value = [&]() -> std::string {
       if (i + 1 >= argc) throw Error(a + " needs a value (see --help)");
       return argv[++i];
     };
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage;
-      return 0;
-    } else if (a == "--model") {
-      opt.model = value();
-    } else if (a == "--extra-model") {
-      if (single) throw Error("--single-model and --extra-model exclude each other");
-      if (!extra_given) opt.extra_models.clear();
-      extra_given = true;
-      opt.extra_models.push_back(value());
-    } else if (a == "--single-model") {
-      if (extra_given) throw Error("--single-model and --extra-model exclude each other");
-      single = true;
-      opt.extra_models.clear();
-    } else if (a == "--json") {
-      json = true;
-    } else if (a == "--draw") {
-      draw = value();
-    } else if (a == "--draw-dir") {
-      draw_dir = value();
-    } else if (a == "--conf") {
-      opt.conf_threshold = parseFloat(a, value());
-    } else if (a == "--nms") {
-      opt.nms_threshold = parseFloat(a, value());
-    } else if (a == "--threads") {
-      opt.threads = int(parseFloat(a, value()));
-    } else if (a == "--no-letterbox") {
-      opt.letterbox = false;
-    } else if (a == "--size") {
-      std::string v = value();
-      if (std::sscanf(v.c_str(), "%dx%d", &opt.input_width, &opt.input_height) != 2)
-        throw Error("--size needs WxH, e.g. 416x416, got '" + v + "'");
-    } else if (a == "--classes") {
-      std::string v = value();
-      opt.dynamic_classes.clear();
-      size_t start = 0;
-      while (start <= v.size()) {
-        size_t comma = v.find(',', start);
-        std::string c = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        if (!c.empty()) opt.dynamic_classes.push_back(c);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-      }
-    } else if (!a.empty() && a[0] == '-') {
-      throw Error("unknown option " + a + " (see --help)");
-    } else {
-      images.push_back(a);
-    }
+    if (parseOption(a, value, d)) continue;
+    if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see --help)");
+    d.images.push_back(a);
   }
-  if (images.empty()) {
-    std::cerr << kUsage;
-    return 1;
-  }
-  if (!draw.empty() && images.size() != 1)
+  return d;
+}
+
+void checkArgs(const DetectArgs& d) {
+  const detection::DetectorOptions& opt = d.opt;
+  if (!d.draw.empty() && d.images.size() != 1)
     throw Error("--draw takes one image; use --draw-dir DIR for several");
   if (!(opt.conf_threshold > 0 && opt.conf_threshold < 1)) throw Error("--conf must be in (0,1)");
   if (!(opt.nms_threshold > 0 && opt.nms_threshold <= 1)) throw Error("--nms must be in (0,1]");
-  if (opt.threads < 1) throw Error("--threads must be at least 1");
   if ((opt.input_width % 32) || (opt.input_height % 32) || opt.input_width < 0 || opt.input_height < 0)
     throw Error("--size must be positive multiples of 32");
-  if (!draw_dir.empty() && !dirExists(draw_dir))
-    throw Error("--draw-dir " + draw_dir + " is not an existing folder; create it first");
+  if (!d.draw_dir.empty() && !dirExists(d.draw_dir))
+    throw Error("--draw-dir " + d.draw_dir + " is not an existing folder; create it first");
+}
+
+int run(int argc, char** argv) {
+  const DetectArgs args = parseArgs(argc, argv);
+  if (args.help) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (args.images.empty()) {
+    std::cerr << kUsage;
+    return 1;
+  }
+  checkArgs(args);
+  const detection::DetectorOptions& opt = args.opt;
+  const bool json = args.json;
+  const std::string& draw = args.draw;
+  const std::string& draw_dir = args.draw_dir;
+  const std::vector<std::string>& images = args.images;
 
   std::unique_ptr<detection::Detector> detector = detection::makeDetector(opt);
   if (!json) std::cout << "# model: " << detector->description() << "\n";

@@ -429,15 +429,11 @@ SynthFrame SequenceGenerator::frame(size_t i) const {
   return f;
 }
 
-double SequenceGenerator::generate(const std::string& out_dir, bool progress) const {
-  Stopwatch sw;
-  makeDir(out_dir);
-  for (const char* sub : {"rgb", "depth", "masks"}) makeDir(joinPath(out_dir, sub));
+void SequenceGenerator::renderFrames(const std::string& out_dir, bool progress,
+                                     std::vector<std::vector<ObjectTruth>>& objects, Trajectory& gt) const {
   const size_t n = size();
-  std::vector<std::vector<ObjectTruth>> objects(n);
-  Trajectory gt(n);
   std::atomic<size_t> next{0};
-  std::mutex err_mu;  // guards first_error
+  std::mutex err_mu;  // guards first_error and the progress bar
   std::exception_ptr first_error;
   std::atomic<size_t> done{0};
   ProgressBar bar("synth " + preset_.name, n);
@@ -475,47 +471,57 @@ double SequenceGenerator::generate(const std::string& out_dir, bool progress) co
   for (auto& th : pool) th.join();
   if (first_error) std::rethrow_exception(first_error);
   if (progress) bar.finish();
+}
 
-  auto open = [&](const std::string& name) {
-    auto f = std::make_unique<std::ofstream>(joinPath(out_dir, name));
-    if (!*f) throw Error("cannot write " + joinPath(out_dir, name) + ": check permissions");
-    return f;
-  };
-  const std::string src = "yolo_slam_synth --preset " + preset_.name + " --seed " + std::to_string(opt_.seed);
+namespace {
+
+std::unique_ptr<std::ofstream> openOutput(const std::string& out_dir, const std::string& name) {
+  auto f = std::make_unique<std::ofstream>(joinPath(out_dir, name));
+  if (!*f) throw Error("cannot write " + joinPath(out_dir, name) + ": check permissions");
+  return f;
+}
+
+}  // namespace
+
+void SequenceGenerator::writeLists(const std::string& out_dir, const std::string& src) const {
+  const size_t n = size();
   {
-    auto f = open("rgb.txt");
+    auto f = openOutput(out_dir, "rgb.txt");
     *f << "# color images\n# file: '" << src << "'\n# timestamp filename\n";
     for (size_t i = 0; i < n; ++i) *f << stampStr(rgb_stamps_[i]) << " rgb/" << stampStr(rgb_stamps_[i]) << ".png\n";
   }
   {
-    auto f = open("depth.txt");
+    auto f = openOutput(out_dir, "depth.txt");
     *f << "# depth maps\n# file: '" << src << "'\n# timestamp filename\n";
     for (size_t i = 0; i < n; ++i) *f << stampStr(depth_stamps_[i]) << " depth/" << stampStr(depth_stamps_[i]) << ".png\n";
   }
-  {
-    // ORB-SLAM2's association format (no header: its reader does not skip comments).
-    auto f = open("associations.txt");
-    for (size_t i = 0; i < n; ++i)
-      *f << stampStr(rgb_stamps_[i]) << " rgb/" << stampStr(rgb_stamps_[i]) << ".png " << stampStr(depth_stamps_[i])
-         << " depth/" << stampStr(depth_stamps_[i]) << ".png\n";
-  }
-  {
-    auto f = open("boxes.txt");
-    *f << "# dynamic objects per frame (" << src << ")\n"
-       << "# box = visible pixels; x2 y2 exclusive; visible_fraction = visible / unoccluded unclipped area\n"
-       << "# rgb_timestamp id class x1 y1 x2 y2 visible_fraction\n";
-    char buf[256];
-    for (size_t i = 0; i < n; ++i)
-      for (const auto& o : objects[i]) {
-        std::snprintf(buf, sizeof buf, "%s %d %s %d %d %d %d %.3f\n", stampStr(rgb_stamps_[i]).c_str(), o.id,
-                      o.cls.c_str(), o.box.x, o.box.y, o.box.x + o.box.width, o.box.y + o.box.height,
-                      o.visible_fraction);
-        *f << buf;
-      }
-  }
+  // ORB-SLAM2's association format (no header: its reader does not skip comments).
+  auto f = openOutput(out_dir, "associations.txt");
+  for (size_t i = 0; i < n; ++i)
+    *f << stampStr(rgb_stamps_[i]) << " rgb/" << stampStr(rgb_stamps_[i]) << ".png " << stampStr(depth_stamps_[i])
+       << " depth/" << stampStr(depth_stamps_[i]) << ".png\n";
+}
+
+void SequenceGenerator::writeBoxes(const std::string& out_dir, const std::string& src,
+                                   const std::vector<std::vector<ObjectTruth>>& objects) const {
+  auto f = openOutput(out_dir, "boxes.txt");
+  *f << "# dynamic objects per frame (" << src << ")\n"
+     << "# box = visible pixels; x2 y2 exclusive; visible_fraction = visible / unoccluded unclipped area\n"
+     << "# rgb_timestamp id class x1 y1 x2 y2 visible_fraction\n";
+  char buf[256];
+  for (size_t i = 0; i < objects.size(); ++i)
+    for (const auto& o : objects[i]) {
+      std::snprintf(buf, sizeof buf, "%s %d %s %d %d %d %d %.3f\n", stampStr(rgb_stamps_[i]).c_str(), o.id,
+                    o.cls.c_str(), o.box.x, o.box.y, o.box.x + o.box.width, o.box.y + o.box.height,
+                    o.visible_fraction);
+      *f << buf;
+    }
+}
+
+void SequenceGenerator::writeCameraAndInfo(const std::string& out_dir, const std::string& src) const {
   {
     const CameraModel& c = opt_.camera;
-    auto f = open("camera.yaml");
+    auto f = openOutput(out_dir, "camera.yaml");
     char buf[2048];
     std::snprintf(buf, sizeof buf,
                   "%%YAML:1.0\n# Camera of a yolo_slam_synth sequence (%s): ORB-SLAM2 keys.\n"
@@ -529,14 +535,25 @@ double SequenceGenerator::generate(const std::string& out_dir, bool progress) co
                   c.depth_map_factor);
     *f << buf;
   }
-  {
-    auto f = open("synth_info.txt");
-    *f << "# how this sequence was made\ncommand: " << src << " --frames " << n << "\n"
-       << "description: " << preset_.description << "\ntrajectory: " << path_->name() << "\ntextures:";
-    for (const auto& t : texture_files_) *f << " " << t;
-    *f << "\n";
-    for (const Person& p : people_) *f << "person " << p.id << ": " << p.track->source << "\n";
-  }
+  auto f = openOutput(out_dir, "synth_info.txt");
+  *f << "# how this sequence was made\ncommand: " << src << " --frames " << size() << "\n"
+     << "description: " << preset_.description << "\ntrajectory: " << path_->name() << "\ntextures:";
+  for (const auto& t : texture_files_) *f << " " << t;
+  *f << "\n";
+  for (const Person& p : people_) *f << "person " << p.id << ": " << p.track->source << "\n";
+}
+
+double SequenceGenerator::generate(const std::string& out_dir, bool progress) const {
+  Stopwatch sw;
+  makeDir(out_dir);
+  for (const char* sub : {"rgb", "depth", "masks"}) makeDir(joinPath(out_dir, sub));
+  std::vector<std::vector<ObjectTruth>> objects(size());
+  Trajectory gt(size());
+  renderFrames(out_dir, progress, objects, gt);
+  const std::string src = "yolo_slam_synth --preset " + preset_.name + " --seed " + std::to_string(opt_.seed);
+  writeLists(out_dir, src);
+  writeBoxes(out_dir, src, objects);
+  writeCameraAndInfo(out_dir, src);
   io::writeTrajectory(joinPath(out_dir, "groundtruth.txt"), gt);
   return sw.ms() / 1000.0;
 }

@@ -78,21 +78,23 @@ struct Blob {
   cv::Mat bgr, mask;  // crops
 };
 
-}  // namespace
+// Frames of the walker video read at most: the first minute holds enough walkers.
+constexpr int kWalkerVideoFrames = 600;
+constexpr int kBackgroundSampleStep = 12;   // every 12th frame votes in the median background
+constexpr int kForegroundThreshold = 28;    // colour difference from the background (0-255)
+constexpr int kMinBlobArea = 400, kMinBlobHeight = 50;  // pixels
+constexpr int kMinTrackFrames = 25;         // 2.5 s at the video's 10 fps
 
-std::vector<SpriteTrack> extractWalkers(const std::string& video_path, int max_tracks) {
-  const int kFrames = 600;  // the first minute holds enough walkers; bounds the cost
-  cv::VideoCapture cap(video_path);
-  if (!cap.isOpened())
-    throw Error("cannot open the walker video " + video_path +
-                ": install opencv-doc (it ships examples/data/vtest.avi) or pass another video");
-  // Pass 1: per-pixel median of every 12th frame is the empty background.
+// Per-pixel median of every kBackgroundSampleStep-th frame: the empty background. `frames_read`
+// is how many frames the video gave (at most kWalkerVideoFrames).
+cv::Mat medianBackground(cv::VideoCapture& cap, const std::string& video_path, int& frames_read) {
   std::vector<cv::Mat> samples;
   cv::Mat frame;
   int n = 0;
-  for (; n < kFrames && cap.read(frame); ++n)
-    if (n % 12 == 0) samples.push_back(frame.clone());
+  for (; n < kWalkerVideoFrames && cap.read(frame); ++n)
+    if (n % kBackgroundSampleStep == 0) samples.push_back(frame.clone());
   if (samples.size() < 5) throw Error("walker video " + video_path + " is too short or corrupt");
+  frames_read = n;
   const cv::Size sz = samples[0].size();
   cv::Mat bg(sz, CV_8UC3);
   std::vector<uchar> vals(samples.size());
@@ -102,57 +104,62 @@ std::vector<SpriteTrack> extractWalkers(const std::string& video_path, int max_t
       std::nth_element(vals.begin(), vals.begin() + vals.size() / 2, vals.end());
       bg.ptr<uchar>(y)[x] = vals[vals.size() / 2];
     }
-  samples.clear();
+  return bg;
+}
 
-  // Pass 2: foreground blobs per frame.
-  cap.release();
-  cap.open(video_path);
-  const cv::Mat k_open = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
-  const cv::Mat k_close = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(7, 11));
-  std::vector<std::vector<Blob>> blobs;
-  for (int f = 0; f < n && cap.read(frame); ++f) {
-    cv::Mat diff;
-    cv::absdiff(frame, bg, diff);
-    std::vector<cv::Mat> ch;
-    cv::split(diff, ch);
-    cv::Mat fg = cv::max(cv::max(ch[0], ch[1]), ch[2]) > 28;
-    cv::morphologyEx(fg, fg, cv::MORPH_OPEN, k_open);
-    cv::morphologyEx(fg, fg, cv::MORPH_CLOSE, k_close);
-    cv::Mat labels, stats, cents;
-    int nl = cv::connectedComponentsWithStats(fg, labels, stats, cents, 8, CV_32S);
-    std::vector<Blob> fb;
-    for (int l = 1; l < nl; ++l) {
-      Blob b;
-      b.frame = f;
-      b.box = cv::Rect(stats.at<int>(l, 0), stats.at<int>(l, 1), stats.at<int>(l, 2), stats.at<int>(l, 3));
-      b.area = stats.at<int>(l, 4);
-      if (b.area < 400 || b.box.height < 50) continue;
-      b.centroid = cv::Point2f((float)cents.at<double>(l, 0), (float)cents.at<double>(l, 1));
-      double aspect = (double)b.box.width / b.box.height;
-      bool border = b.box.x <= 2 || b.box.y <= 2 || b.box.br().x >= sz.width - 2 ||
-                    b.box.br().y >= sz.height - 2;
-      double fill = (double)b.area / b.box.area();
-      b.clean = !border && aspect > 0.22 && aspect < 0.6 && fill > 0.45;
-      if (b.clean) {
-        cv::Rect r = (b.box + cv::Size(6, 6) - cv::Point(3, 3)) & cv::Rect(0, 0, sz.width, sz.height);
-        b.bgr = frame(r).clone();
-        b.mask = (labels(r) == l);
-        // Fill holes: everything not reachable from the crop border is inside.
-        cv::Mat inv = b.mask.clone();
-        cv::Mat pad;
-        cv::copyMakeBorder(inv, pad, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
-        cv::floodFill(pad, cv::Point(0, 0), 128);
-        b.mask = (pad(cv::Rect(1, 1, r.width, r.height)) != 128);
-        b.box = r;
-      }
-      fb.push_back(b);
-    }
-    blobs.push_back(std::move(fb));
+// A clean blob keeps its crop (colour, and its mask with the holes filled).
+void cropBlob(Blob& b, const cv::Mat& frame, const cv::Mat& labels, int label) {
+  cv::Rect r = (b.box + cv::Size(6, 6) - cv::Point(3, 3)) & cv::Rect(0, 0, frame.cols, frame.rows);
+  b.bgr = frame(r).clone();
+  b.mask = (labels(r) == label);
+  // Fill holes: everything not reachable from the crop border is inside.
+  cv::Mat pad;
+  cv::copyMakeBorder(b.mask, pad, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::floodFill(pad, cv::Point(0, 0), 128);
+  b.mask = (pad(cv::Rect(1, 1, r.width, r.height)) != 128);
+  b.box = r;
+}
+
+// Foreground blobs of one frame; "clean" ones look like one whole walker.
+std::vector<Blob> frameBlobs(const cv::Mat& frame, const cv::Mat& bg, int f) {
+  static const cv::Mat k_open = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
+  static const cv::Mat k_close = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(7, 11));
+  cv::Mat diff;
+  cv::absdiff(frame, bg, diff);
+  std::vector<cv::Mat> ch;
+  cv::split(diff, ch);
+  cv::Mat fg = cv::max(cv::max(ch[0], ch[1]), ch[2]) > kForegroundThreshold;
+  cv::morphologyEx(fg, fg, cv::MORPH_OPEN, k_open);
+  cv::morphologyEx(fg, fg, cv::MORPH_CLOSE, k_close);
+  cv::Mat labels, stats, cents;
+  const int nl = cv::connectedComponentsWithStats(fg, labels, stats, cents, 8, CV_32S);
+  std::vector<Blob> fb;
+  for (int l = 1; l < nl; ++l) {
+    Blob b;
+    b.frame = f;
+    b.box = cv::Rect(stats.at<int>(l, 0), stats.at<int>(l, 1), stats.at<int>(l, 2), stats.at<int>(l, 3));
+    b.area = stats.at<int>(l, 4);
+    if (b.area < kMinBlobArea || b.box.height < kMinBlobHeight) continue;
+    b.centroid = cv::Point2f((float)cents.at<double>(l, 0), (float)cents.at<double>(l, 1));
+    const double aspect = (double)b.box.width / b.box.height;
+    const bool border = b.box.x <= 2 || b.box.y <= 2 || b.box.br().x >= frame.cols - 2 ||
+                        b.box.br().y >= frame.rows - 2;
+    const double fill = (double)b.area / b.box.area();
+    b.clean = !border && aspect > 0.22 && aspect < 0.6 && fill > 0.45;
+    if (b.clean) cropBlob(b, frame, labels, l);
+    fb.push_back(b);
   }
+  return fb;
+}
 
-  // Link blobs frame to frame (greedy nearest centroid, similar height) into tracks; a track
-  // ends when its blob is lost, merges (unclean) or two candidates compete.
-  struct Track { std::vector<const Blob*> blobs; bool open = true; };
+struct Track {
+  std::vector<const Blob*> blobs;
+  bool open = true;
+};
+
+// Links blobs frame to frame (greedy nearest centroid, similar height) into tracks; a track
+// ends when its blob is lost, merges (unclean) or two candidates compete.
+std::vector<Track> linkTracks(const std::vector<std::vector<Blob>>& blobs) {
   std::vector<Track> tracks;
   std::vector<int> active;  // indices of open tracks
   for (size_t f = 0; f < blobs.size(); ++f) {
@@ -164,8 +171,8 @@ std::vector<SpriteTrack> extractWalkers(const std::string& video_path, int max_t
       double bd = 1e9;
       for (size_t j = 0; j < blobs[f].size(); ++j) {
         const Blob& b = blobs[f][j];
-        double d = cv::norm(b.centroid - last->centroid);
-        double hr = (double)b.box.height / last->box.height;
+        const double d = cv::norm(b.centroid - last->centroid);
+        const double hr = (double)b.box.height / last->box.height;
         if (d < 0.3 * last->box.height && hr > 0.8 && hr < 1.25) {
           ++cands;
           if (d < bd) bd = d, best = (int)j;
@@ -184,48 +191,75 @@ std::vector<SpriteTrack> extractWalkers(const std::string& video_path, int max_t
       }
     active = next_active;
   }
+  return tracks;
+}
 
-  // Rank runs of at least 25 frames (2.5 s) by length times size: big, long walkers first.
+// Tracks of at least kMinTrackFrames that walk across the view, ranked by length times size:
+// big, long walkers first. Returns (score, track index), best first.
+std::vector<std::pair<double, int>> rankTracks(const std::vector<Track>& tracks) {
   std::vector<std::pair<double, int>> rank;
   for (size_t i = 0; i < tracks.size(); ++i) {
     const auto& t = tracks[i].blobs;
-    if (t.size() < 25) continue;
+    if (t.size() < static_cast<size_t>(kMinTrackFrames)) continue;
     std::vector<int> hs;
     for (auto* b : t) hs.push_back(b->box.height);
     std::nth_element(hs.begin(), hs.begin() + hs.size() / 2, hs.end());
-    double dx = t.back()->centroid.x - t.front()->centroid.x;
+    const double dx = t.back()->centroid.x - t.front()->centroid.x;
     if (std::abs(dx) < 0.5 * hs[hs.size() / 2]) continue;  // standing or walking at the camera
     rank.emplace_back(-(double)std::min<size_t>(t.size(), 80) * hs[hs.size() / 2], (int)i);
   }
   std::sort(rank.begin(), rank.end());
-  std::vector<SpriteTrack> out;
-  for (const auto& r : rank) {
-    if ((int)out.size() >= max_tracks) break;
-    const auto& t = tracks[r.second].blobs;
-    bool left = t.back()->centroid.x < t.front()->centroid.x;
-    SpriteTrack st;
-    st.source = video_path + " frames " + std::to_string(t.front()->frame) + "-" +
-                std::to_string(t.back()->frame);
-    st.fps = cap.get(cv::CAP_PROP_FPS) > 0 ? cap.get(cv::CAP_PROP_FPS) : 10.0;
-    std::vector<cv::Rect> bbs;
-    for (auto* b : t) bbs.push_back(cv::boundingRect(b->mask));
-    for (size_t i = 0; i < t.size(); ++i) {
-      cv::Mat bgr = t[i]->bgr, mask = t[i]->mask;
-      if (left) {  // store every walker facing right
-        cv::flip(bgr, bgr, 1);
-        cv::flip(mask, mask, 1);
-      }
-      // Crop to the silhouette's own rows so the feet sit on the quad's bottom edge.
-      cv::Rect bb = cv::boundingRect(mask);  // of the flipped mask
-      st.frames.push_back(makeSprite(bgr(bb), mask(bb), cv::Mat(), 0.25));
-      // Height relative to a moving average: keeps the gait bob, removes perspective growth.
-      double sum = 0;
-      int cnt = 0;
-      for (int k = std::max(0, (int)i - 5); k <= std::min((int)t.size() - 1, (int)i + 5); ++k)
-        sum += bbs[k].height, ++cnt;
-      st.height_scale.push_back((float)(bb.height / (sum / cnt)));
+  return rank;
+}
+
+// The track's sprites, every walker facing right, with its gait's height relative to a moving
+// average (keeps the bob, removes perspective growth).
+SpriteTrack spriteTrack(const Track& track, const std::string& video_path, double fps) {
+  const auto& t = track.blobs;
+  const bool left = t.back()->centroid.x < t.front()->centroid.x;
+  SpriteTrack st;
+  st.source = video_path + " frames " + std::to_string(t.front()->frame) + "-" + std::to_string(t.back()->frame);
+  st.fps = fps;
+  std::vector<cv::Rect> bbs;
+  for (auto* b : t) bbs.push_back(cv::boundingRect(b->mask));
+  for (size_t i = 0; i < t.size(); ++i) {
+    cv::Mat bgr = t[i]->bgr, mask = t[i]->mask;
+    if (left) {
+      cv::flip(bgr, bgr, 1);
+      cv::flip(mask, mask, 1);
     }
-    out.push_back(std::move(st));
+    // Crop to the silhouette's own rows so the feet sit on the quad's bottom edge.
+    const cv::Rect bb = cv::boundingRect(mask);  // of the flipped mask
+    st.frames.push_back(makeSprite(bgr(bb), mask(bb), cv::Mat(), 0.25));
+    double sum = 0;
+    int cnt = 0;
+    for (int k = std::max(0, (int)i - 5); k <= std::min((int)t.size() - 1, (int)i + 5); ++k)
+      sum += bbs[k].height, ++cnt;
+    st.height_scale.push_back((float)(bb.height / (sum / cnt)));
+  }
+  return st;
+}
+
+}  // namespace
+
+std::vector<SpriteTrack> extractWalkers(const std::string& video_path, int max_tracks) {
+  cv::VideoCapture cap(video_path);
+  if (!cap.isOpened())
+    throw Error("cannot open the walker video " + video_path +
+                ": install opencv-doc (it ships examples/data/vtest.avi) or pass another video");
+  int n = 0;
+  const cv::Mat bg = medianBackground(cap, video_path, n);
+  cap.release();
+  cap.open(video_path);
+  std::vector<std::vector<Blob>> blobs;
+  cv::Mat frame;
+  for (int f = 0; f < n && cap.read(frame); ++f) blobs.push_back(frameBlobs(frame, bg, f));
+  const std::vector<Track> tracks = linkTracks(blobs);
+  const double fps = cap.get(cv::CAP_PROP_FPS) > 0 ? cap.get(cv::CAP_PROP_FPS) : 10.0;
+  std::vector<SpriteTrack> out;
+  for (const auto& r : rankTracks(tracks)) {
+    if ((int)out.size() >= max_tracks) break;
+    out.push_back(spriteTrack(tracks[r.second], video_path, fps));
   }
   if (out.empty()) throw Error("no usable walker found in video " + video_path);
   return out;

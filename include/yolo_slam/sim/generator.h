@@ -98,6 +98,14 @@ class SequenceGenerator {
   double generate(const std::string& out_dir, bool progress = false) const;
 
  private:
+  // generate()'s phases: every frame's images (in parallel) with its objects and pose, then
+  // the lists, the boxes, camera.yaml and synth_info.txt. `src` is the command that made them.
+  void renderFrames(const std::string& out_dir, bool progress, std::vector<std::vector<ObjectTruth>>& objects,
+                    Trajectory& gt) const;
+  void writeLists(const std::string& out_dir, const std::string& src) const;
+  void writeBoxes(const std::string& out_dir, const std::string& src,
+                  const std::vector<std::vector<ObjectTruth>>& objects) const;
+  void writeCameraAndInfo(const std::string& out_dir, const std::string& src) const;
   struct Person;
   std::vector<Quad> dynamicQuads(double t, const Pose& T_wc) const;
 
