@@ -16,6 +16,10 @@
 #   :veto / :noveto   static-box veto on / off (--static-box-veto)
 #   :prop / :noprop   label propagation on / off (--propagate-labels)
 #   :single   the main detection model alone, without Detector.extraModels (--single-model)
+#   :every / :async   detection on every frame before it is screened (the paper's pipeline,
+#             the measurements before 2026-12-01) / asynchronous detection (the default)
+#   :seq      the deterministic mode (--sequential): one run is all runs
+#   :camera   frames fed at 30 Hz as a live camera, dropped while busy (--camera-rate)
 # ":notrack:noveto:noprop:single" is the paper's method as printed.
 # Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
 # OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
@@ -80,6 +84,10 @@ suffix_options() {
       prop) extra+=(--propagate-labels on) ;;
       noprop) extra+=(--propagate-labels off) ;;
       single) extra+=(--single-model) ;;
+      every) extra+=(--detection every-frame) ;;
+      async) extra+=(--detection async) ;;
+      seq) extra+=(--sequential) ;;
+      camera) extra+=(--camera-rate) ;;
       *) return 1 ;;
     esac
   done
@@ -90,7 +98,7 @@ for m in $modes; do
     off|detect|geometry|detect+geometry) ;;
     *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
-  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :single" >&2; exit 1; }
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :single :every :async :seq :camera" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

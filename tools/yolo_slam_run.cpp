@@ -8,9 +8,11 @@
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/progress.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/detection/detector.h"
 #include "yolo_slam/eval/ate.h"
 #include "yolo_slam/io/atomic_file.h"
+#include "yolo_slam/io/camera_feed.h"
 #include "yolo_slam/io/text_table.h"
 #include "yolo_slam/io/trajectory.h"
 #include "yolo_slam/io/tum_sequence.h"
@@ -28,6 +30,7 @@
 #include <fstream>
 #include <future>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <sys/stat.h>
@@ -48,7 +51,8 @@ void onSignal(int sig) {
 const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
 
 const char* kUsage =
-    "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N] [--realtime]\n"
+    "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N]\n"
+    "                     [--realtime | --camera-rate] [--detection async|every-frame]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
     "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
@@ -71,6 +75,14 @@ const char* kUsage =
     "                     DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
     "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
+    "  --camera-rate      feed frames at the sequence's timestamps as a camera does: a frame\n"
+    "                     that arrives while the pipeline is busy replaces the waiting one\n"
+    "                     (dropped); stats.json \"camera\" has offered/processed/dropped frames\n"
+    "                     and the latency from a frame's arrival to its pose\n"
+    "  --detection M      --set Detection.async=1 (async, the default: the detector works on\n"
+    "                     the newest frame whenever it is free, frames never wait for it) or 0\n"
+    "                     (every-frame: each frame is detected before it is screened, the\n"
+    "                     paper's pipeline)\n"
     "  --set KEY=VALUE    override a settings key (repeatable; YAML value: a number, a word or\n"
     "                     [a, b]), e.g. --set Screening.boxDilation=0.1; the effective settings\n"
     "                     are written to stats.json (\"settings\")\n"
@@ -103,7 +115,7 @@ struct Args {
   // Settings overrides in command-line order (--set and the flags that stand for a key).
   std::vector<std::string> overrides;
   long max_frames = -1;
-  bool realtime = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
+  bool realtime = false, camera_rate = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
        single_model = false;
 };
 
@@ -111,6 +123,12 @@ struct Args {
 std::string onOffOverride(const std::string& flag, const std::string& key, const std::string& v) {
   if (v != "on" && v != "off") throw Error(flag + " must be on or off (got '" + v + "')");
   return key + "=" + (v == "on" ? "1" : "0");
+}
+
+std::string detectionOverride(const std::string& v) {
+  if (v != "async" && v != "every-frame")
+    throw Error("--detection must be async or every-frame (got '" + v + "')");
+  return std::string("Detection.async=") + (v == "async" ? "1" : "0");
 }
 
 long positiveLong(const std::string& flag, const std::string& v) {
@@ -156,6 +174,8 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--set") a.overrides.push_back(need(i, s));
     else if (s == "--dynamic-mode") a.overrides.push_back("Screening.mode=" + need(i, s));
     else if (s == "--realtime") a.realtime = true;
+    else if (s == "--camera-rate") a.camera_rate = true;
+    else if (s == "--detection") a.overrides.push_back(detectionOverride(need(i, s)));
     else if (s == "--sequential") a.overrides.push_back("System.sequential=1");
     else if (s == "--boxes-from-gt") a.boxes_from_gt = true;
     else if (s == "--boxes") a.boxes_file = need(i, s);
@@ -174,6 +194,7 @@ Args parseArgs(int argc, char** argv) {
     throw Error(std::string("--sequence and --out are required\n") + kUsage);
   if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
   if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
+  if (a.realtime && a.camera_rate) throw Error("--realtime and --camera-rate exclude each other");
   resolveDefaultFiles(a);
   return a;
 }
@@ -221,6 +242,7 @@ struct Prepared {
   double detection_ms = -1;
   cv::Mat mask;  // ground-truth dynamic mask (synthetic sequences), empty if none
   std::string mask_path;
+  std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
 };
 
 std::string baseName(const std::string& path) {
@@ -271,7 +293,9 @@ struct RunSetup {
   io::TumSequence seq;
   size_t frames = 0;
   std::map<long long, detection::Boxes> file_boxes;  // --boxes-from-gt / --boxes
-  std::unique_ptr<detection::Detector> detector;
+  std::unique_ptr<detection::Detector> detector;       // every-frame detection
+  std::unique_ptr<detection::AsyncDetector> async;     // Detection.async (then detector is null)
+  double max_box_age_s = 0;                            // Detection.maxAge
   std::string boxes_source = "none";
   std::shared_ptr<const vocabulary::Vocabulary> voc;
   std::string mask_dir;  // synthetic sequences: per-frame masks, masks/<rgb file name>
@@ -293,6 +317,12 @@ void setUpBoxes(const Args& args, RunSetup& r) {
     r.detector = detection::makeDetector(dopt);
     r.boxes_source = dopt.model;
     for (const auto& m : dopt.extra_models) r.boxes_source += " + " + m;
+    const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(r.cfg);
+    if (aopt.enabled) {
+      r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector));
+      r.max_box_age_s = aopt.max_age_s;
+      r.boxes_source += " (async)";
+    }
   }
 }
 
@@ -315,7 +345,7 @@ RunSetup setUp(const Args& args) {
 }
 
 void detectInto(const RunSetup& r, Prepared& p) {
-  if (!r.stages.detection) return;
+  if (!r.stages.detection || r.async) return;
   if (!r.detector) {
     auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
     if (it != r.file_boxes.end()) p.boxes = it->second;
@@ -370,9 +400,71 @@ Prepared prepareFrame(const RunSetup& r, size_t i) {
 struct LoopResult {
   size_t skipped = 0, processed = 0, lost_reports = 0;
   std::vector<double> frame_ms;
+  std::vector<double> latency_ms;  // --camera-rate: arrival to pose
+  long camera_offered = 0, camera_dropped = 0;
+  long boxes_fresh = 0, boxes_expired = 0;  // async detection: frames given a new result
   MetricsAccumulator metrics;
   double total_s = 0;
   double fps() const { return total_s > 0 ? static_cast<double>(processed + skipped) / total_s : 0.0; }
+};
+
+// Frames in sequence order, each loaded (and, with every-frame detection, detected) in a
+// worker while the one before it is tracked; --realtime paces them at their stamps.
+class PrefetchSource {
+ public:
+  PrefetchSource(const RunSetup& setup, bool realtime)
+      : setup_(setup), realtime_(realtime), wall0_(std::chrono::steady_clock::now()),
+        stamp0_(setup.frames ? setup.seq.frames()[0].rgb_stamp : 0) {
+    if (setup_.frames > 0) start(0);
+  }
+  ~PrefetchSource() {
+    if (next_.valid()) next_.wait();
+  }
+  std::optional<Prepared> next() {
+    if (i_ >= setup_.frames) return std::nullopt;
+    Prepared p = next_.get();
+    if (++i_ < setup_.frames) start(i_);
+    if (realtime_) {
+      const auto due = wall0_ + std::chrono::duration<double>(p.stamp - stamp0_);
+      std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
+    }
+    p.arrival = std::chrono::steady_clock::now();
+    return p;
+  }
+
+ private:
+  void start(size_t i) {
+    next_ = std::async(std::launch::async, [this, i] { return prepareFrame(setup_, i); });
+  }
+  const RunSetup& setup_;
+  const bool realtime_;
+  const std::chrono::steady_clock::time_point wall0_;
+  const double stamp0_;
+  size_t i_ = 0;
+  std::future<Prepared> next_;
+};
+
+// --camera-rate: frames as a live camera gives them (io::CameraFeed), newest wins.
+class CameraSource {
+ public:
+  explicit CameraSource(const RunSetup& setup)
+      : feed_(stampsOf(setup), [&setup](size_t i) { return prepareFrame(setup, i); }) {}
+  std::optional<Prepared> next() {
+    std::optional<io::CameraFeed<Prepared>::Arrived> a = feed_.next();
+    if (!a) return std::nullopt;
+    a->frame.arrival = a->due;
+    return std::move(a->frame);
+  }
+  long offered() const { return feed_.offered(); }
+  long dropped() const { return feed_.dropped(); }
+
+ private:
+  static std::vector<double> stampsOf(const RunSetup& setup) {
+    std::vector<double> stamps;
+    for (size_t i = 0; i < setup.frames; ++i) stamps.push_back(setup.seq.frames()[i].rgb_stamp);
+    return stamps;
+  }
+  io::CameraFeed<Prepared> feed_;
 };
 
 // Every box screened, per frame, in the synthetic boxes.txt format: to inspect the detector
@@ -400,10 +492,21 @@ void evaluateFrame(const slam::System& system, const Prepared& p, MetricsAccumul
   }
 }
 
-// --realtime: frame i is due at its stamp's offset from the first frame's.
-void waitUntilDue(const Prepared& p, double stamp0, std::chrono::steady_clock::time_point wall0) {
-  const auto due = wall0 + std::chrono::duration<double>(p.stamp - stamp0);
-  std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
+// Async detection: offers the frame to the detector and screens it with the newest result if
+// it is fresh and recent; otherwise with no detection (the box tracker carries earlier boxes).
+void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared& p, slam::System& system,
+                      LoopResult& res) {
+  if (!setup.async || !p.has_image) return;
+  setup.async->offer(p.bgr, static_cast<long>(p.index), p.stamp);
+  const std::optional<detection::DetectionResult> newest = setup.async->newest();
+  const long expired_before = feed.expired();
+  const detection::FrameBoxes fb = feed.take(newest, p.stamp);
+  res.boxes_expired += feed.expired() - expired_before;
+  if (!fb.fresh) return;
+  ++res.boxes_fresh;
+  p.boxes = fb.boxes;
+  system.recordDetectionTime(newest->ms);
+  if (!newest->error.empty()) p.warning += (p.warning.empty() ? "" : "; ") + ("detector failed: " + newest->error);
 }
 
 void trackFrame(slam::System& system, const Prepared& p, std::ofstream& boxes_out, LoopResult& res) {
@@ -420,35 +523,44 @@ void trackFrame(slam::System& system, const Prepared& p, std::ofstream& boxes_ou
   evaluateFrame(system, p, res.metrics);
 }
 
-LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system) {
-  LoopResult res;
-  const size_t n = setup.frames;
-  ProgressBar bar("yolo_slam_run", n);
-  Stopwatch total;
-  const auto wall0 = std::chrono::steady_clock::now();
-  const double stamp0 = n ? setup.seq.frames()[0].rgb_stamp : 0;
+template <class Source>
+void runFrames(Source& source, const Args& args, const RunSetup& setup, slam::System& system, LoopResult& res) {
+  ProgressBar bar("yolo_slam_run", setup.frames);
   std::ofstream boxes_out;
   if (setup.stages.detection) {
     boxes_out.open(joinPath(args.out, "boxes_screened.txt"));
     boxes_out << "# rgb_stamp index label x1 y1 x2 y2 score tracked\n";
   }
-  auto prepare = [&setup](size_t i) { return prepareFrame(setup, i); };
-  std::future<Prepared> next;
-  if (n > 0) next = std::async(std::launch::async, prepare, size_t{0});
-  for (size_t i = 0; i < n && !g_stop; ++i) {
+  detection::BoxFeed feed(setup.max_box_age_s);
+  while (!g_stop) {
     Stopwatch fsw;
-    Prepared p = next.get();
-    // Detection of frame i+1 overlaps the tracking of frame i.
-    if (i + 1 < n) next = std::async(std::launch::async, prepare, i + 1);
-    if (args.realtime) waitUntilDue(p, stamp0, wall0);
-    trackFrame(system, p, boxes_out, res);
+    std::optional<Prepared> p = source.next();
+    if (!p) break;
+    attachAsyncBoxes(setup, feed, *p, system, res);
+    trackFrame(system, *p, boxes_out, res);
     res.frame_ms.push_back(fsw.ms());
+    res.latency_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p->arrival).count());
     char extra[96];
     std::snprintf(extra, sizeof extra, "%s, lost %zu", slam::toString(system.state()), res.lost_reports);
-    bar.update(i + 1, extra);
+    bar.update(p->index + 1, extra);
   }
-  if (next.valid()) next.wait();
   bar.finish();
+}
+
+LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system) {
+  LoopResult res;
+  Stopwatch total;
+  if (args.camera_rate) {
+    CameraSource feed(setup);
+    runFrames(feed, args, setup, system, res);
+    res.camera_offered = feed.offered();
+    res.camera_dropped = feed.dropped();
+  } else {
+    PrefetchSource source(setup, args.realtime);
+    runFrames(source, args, setup, system, res);
+  }
+  if (setup.async) setup.async->waitIdle();
   res.total_s = total.ms() / 1000.0;
   return res;
 }
@@ -469,6 +581,18 @@ AteSummary ateOf(const io::TumSequence& seq, const Trajectory& traj) {
     std::fprintf(stderr, "warning: ATE not computed: %s\n", e.what());
   }
   return a;
+}
+
+// How the boxes were had: every frame, or asynchronously (frames given a new result, results
+// dropped for age, what the detector did).
+Json detectionJson(const RunSetup& setup, const LoopResult& res) {
+  if (!setup.stages.detection) return nullptr;
+  if (!setup.async) return Json{{"mode", setup.detector ? "every-frame" : "file"}};
+  const detection::AsyncDetectionCounts c = setup.async->counts();
+  return Json{{"mode", "async"},           {"max_age_s", setup.max_box_age_s},
+              {"offered", c.offered},      {"detected", c.detected},
+              {"replaced", c.replaced},    {"frames_with_new_boxes", res.boxes_fresh},
+              {"results_too_old", res.boxes_expired}};
 }
 
 Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res, size_t poses,
@@ -492,7 +616,14 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res
   j["sequential"] = setup.options.sequential;
   j["vocabulary"] = args.vocabulary;
   j["screening_metrics"] = res.metrics.json();
-  j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}});
+  j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}, {"latency", res.latency_ms}});
+  j["detection"] = detectionJson(setup, res);
+  if (args.camera_rate)
+    j["camera"] = Json{{"offered", res.camera_offered},
+                       {"processed", res.processed + res.skipped},
+                       {"dropped", res.camera_dropped},
+                       {"processed_fraction", jsonRatio(static_cast<long>(res.processed + res.skipped), res.camera_offered)},
+                       {"latency_ms", summaryJsonMs(summarize(res.latency_ms))}};
   j["overrides"] = setup.cfg.overrides();
   j["settings"] = setup.cfg.effective();
   return j;

@@ -314,3 +314,25 @@ TEST_F(RunnerMetrics, CtrlCWritesTheFramesDoneSoFar) {
   EXPECT_GE(frames, 1) << js.dump();
   EXPECT_LT(frames, kFrames) << js.dump();
 }
+
+TEST_F(RunnerMetrics, CameraRateAndAsyncDetectionAccountForEveryFrame) {
+  const std::string out = joinPath(dir_, "out_camera");
+  std::string so, se;
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--camera-rate", "--max-frames", "20"},
+                    joinPath(dir_, "camera"), so, se),
+            0)
+      << so << se;
+  const Json js = statsOf(out);
+  const Json cam = js["camera"];
+  EXPECT_EQ(cam["offered"], 20) << js.dump();
+  EXPECT_EQ(numberOf(cam, "processed") + numberOf(cam, "dropped"), 20) << cam.dump();
+  EXPECT_GE(numberOf(cam, "processed"), 1) << cam.dump();
+  EXPECT_EQ(numberOf(js, "frames"), numberOf(cam, "processed")) << js.dump();
+  EXPECT_EQ(numberOf(js["timings"]["latency"], "count"), numberOf(cam, "processed")) << js.dump();
+  // The default detection is asynchronous: every processed frame was offered to the detector.
+  const Json det = js["detection"];
+  EXPECT_EQ(det["mode"], "async") << det.dump();
+  EXPECT_EQ(numberOf(det, "offered"), numberOf(cam, "processed")) << det.dump();
+  EXPECT_EQ(numberOf(det, "offered"), numberOf(det, "detected") + numberOf(det, "replaced")) << det.dump();
+  EXPECT_GE(numberOf(det, "frames_with_new_boxes"), 1) << det.dump();
+}

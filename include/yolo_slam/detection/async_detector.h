@@ -1,0 +1,104 @@
+#pragma once
+// Detection that never holds up the frame stream (as NGD-SLAM and RDS-SLAM run YOLO): a worker
+// thread detects people in the newest frame offered whenever it is free; a frame offered while
+// another still waits replaces it (no backlog). The stream takes the newest finished result
+// and uses it only while it is recent (AsyncDetectionOptions::max_age_s); between results the
+// screening's box tracker carries the boxes.
+#include "yolo_slam/detection/box.h"
+#include "yolo_slam/detection/detector.h"
+
+#include <opencv2/core.hpp>
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+namespace yolo_slam {
+
+class Config;
+
+namespace detection {
+
+struct AsyncDetectionOptions {
+  // Detection.async: detect asynchronously (default); 0 detects every frame before it is
+  // screened (the paper's pipeline; the offline runner's numbers of docs/ablation.md).
+  bool enabled = true;
+  // Detection.maxAge (seconds): a result is used for a frame at most this much younger than
+  // the result's own frame. People walk about 1.4 m/s: in 0.2 s a box at 2 m is off by about a
+  // tenth of its width, which the box dilation (Screening.boxDilation) and tracker absorb.
+  double max_age_s = 0.2;
+  static AsyncDetectionOptions load(const Config& cfg);  // throws Error naming file and key
+};
+
+struct DetectionResult {
+  long frame = -1;     // the caller's index of the detected frame
+  double stamp = 0;    // its stamp
+  Boxes boxes;
+  double ms = 0;       // detection time
+  std::string error;   // the detector failed on this frame (boxes empty)
+};
+
+struct AsyncDetectionCounts {
+  long offered = 0, detected = 0, replaced = 0;  // replaced: offered, never detected
+};
+
+class AsyncDetector {
+ public:
+  explicit AsyncDetector(std::unique_ptr<Detector> detector);
+  ~AsyncDetector();  // finishes the frame in progress, then stops
+  AsyncDetector(const AsyncDetector&) = delete;
+  AsyncDetector& operator=(const AsyncDetector&) = delete;
+
+  // Offers frame `index` (the image is shared, not copied: the caller must not write to it).
+  void offer(const cv::Mat& bgr, long index, double stamp);
+  // The newest finished result, if any.
+  std::optional<DetectionResult> newest() const;
+  // Blocks until no frame waits and none is being detected (tests, end of a sequence).
+  void waitIdle();
+  AsyncDetectionCounts counts() const;
+  const Detector& detector() const { return *detector_; }
+
+ private:
+  void run();
+
+  std::unique_ptr<Detector> detector_;  // used by the worker only
+  // Guards everything below; taken alone. The worker releases it while it detects.
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  struct Pending {
+    cv::Mat bgr;
+    long index = -1;
+    double stamp = 0;
+  };
+  std::optional<Pending> pending_;
+  bool busy_ = false, stop_ = false;
+  std::optional<DetectionResult> newest_;
+  AsyncDetectionCounts counts_;
+  std::thread worker_;  // started last, in the constructor
+};
+
+// The boxes a frame is screened with, taken from the newest result of an AsyncDetector.
+struct FrameBoxes {
+  Boxes boxes;          // empty when no fresh result: the box tracker carries earlier boxes
+  bool fresh = false;   // a result not used by an earlier frame
+  long source_frame = -1;
+  double age_s = 0;     // frame stamp - result stamp
+};
+
+// Per stream: hands each result to one frame only, and not when it is older than max_age_s.
+class BoxFeed {
+ public:
+  explicit BoxFeed(double max_age_s) : max_age_s_(max_age_s) {}
+  FrameBoxes take(const std::optional<DetectionResult>& newest, double frame_stamp);
+  long expired() const { return expired_; }  // fresh results dropped for age
+
+ private:
+  double max_age_s_;
+  long last_used_ = -1;
+  long expired_ = 0;
+};
+
+}  // namespace detection
+}  // namespace yolo_slam

@@ -1,0 +1,104 @@
+#include "yolo_slam/detection/async_detector.h"
+
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/timing.h"
+
+#include <cmath>
+
+namespace yolo_slam {
+namespace detection {
+
+AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
+  AsyncDetectionOptions o;
+  o.enabled = cfg.getBool("Detection.async", o.enabled);
+  o.max_age_s = cfg.getDouble("Detection.maxAge", o.max_age_s);
+  if (!(o.max_age_s >= 0) || !std::isfinite(o.max_age_s))
+    throw Error((cfg.path().empty() ? std::string("<config>") : cfg.path()) +
+                ": key 'Detection.maxAge' must be >= 0 seconds (got " + std::to_string(o.max_age_s) + ")");
+  return o;
+}
+
+AsyncDetector::AsyncDetector(std::unique_ptr<Detector> detector) : detector_(std::move(detector)) {
+  if (!detector_) throw Error("AsyncDetector needs a detector");
+  worker_ = std::thread([this] { run(); });
+}
+
+AsyncDetector::~AsyncDetector() {
+  {
+    std::lock_guard<std::mutex> lk(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  worker_.join();
+}
+
+void AsyncDetector::offer(const cv::Mat& bgr, long index, double stamp) {
+  {
+    std::lock_guard<std::mutex> lk(mutex_);
+    ++counts_.offered;
+    if (pending_) ++counts_.replaced;
+    pending_ = Pending{bgr, index, stamp};
+  }
+  cv_.notify_all();
+}
+
+std::optional<DetectionResult> AsyncDetector::newest() const {
+  std::lock_guard<std::mutex> lk(mutex_);
+  return newest_;
+}
+
+void AsyncDetector::waitIdle() {
+  std::unique_lock<std::mutex> lk(mutex_);
+  cv_.wait(lk, [this] { return stop_ || (!pending_ && !busy_); });
+}
+
+AsyncDetectionCounts AsyncDetector::counts() const {
+  std::lock_guard<std::mutex> lk(mutex_);
+  return counts_;
+}
+
+void AsyncDetector::run() {
+  std::unique_lock<std::mutex> lk(mutex_);
+  for (;;) {
+    cv_.wait(lk, [this] { return stop_ || pending_; });
+    if (stop_) return;
+    Pending job = std::move(*pending_);
+    pending_.reset();
+    busy_ = true;
+    lk.unlock();
+    DetectionResult r;
+    r.frame = job.index;
+    r.stamp = job.stamp;
+    Stopwatch sw;
+    try {
+      r.boxes = detector_->detect(job.bgr);
+    } catch (const std::exception& e) {
+      r.error = e.what();
+    }
+    r.ms = sw.ms();
+    lk.lock();
+    busy_ = false;
+    ++counts_.detected;
+    newest_ = std::move(r);
+    cv_.notify_all();
+  }
+}
+
+FrameBoxes BoxFeed::take(const std::optional<DetectionResult>& newest, double frame_stamp) {
+  FrameBoxes fb;
+  if (!newest || newest->frame == last_used_) return fb;
+  last_used_ = newest->frame;
+  fb.age_s = frame_stamp - newest->stamp;
+  fb.source_frame = newest->frame;
+  if (fb.age_s > max_age_s_) {
+    ++expired_;
+    return fb;
+  }
+  fb.fresh = true;
+  fb.boxes = newest->boxes;
+  return fb;
+}
+
+}  // namespace detection
+}  // namespace yolo_slam

@@ -1,0 +1,106 @@
+// Asynchronous detection: the stream never waits for the detector, a waiting frame is replaced
+// by a newer one, results reach one frame each and expire with age.
+#include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
+#include "yolo_slam/detection/async_detector.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+using namespace yolo_slam;
+using namespace yolo_slam::detection;
+
+namespace {
+
+// A detector that holds every frame until released, then returns one box whose x is the
+// image's first pixel value (so a result names the frame it came from).
+class GatedDetector : public Detector {
+ public:
+  Boxes detect(const cv::Mat& bgr) override {
+    std::unique_lock<std::mutex> lk(m_);
+    started_.fetch_add(1);
+    cv_.wait(lk, [this] { return open_; });
+    Box b;
+    b.rect = cv::Rect2f(static_cast<float>(bgr.at<uchar>(0, 0)), 0.f, 10.f, 10.f);
+    b.score = 0.9f;
+    return {b};
+  }
+  std::string description() const override { return "gated test detector"; }
+  void open() {
+    {
+      std::lock_guard<std::mutex> lk(m_);
+      open_ = true;
+    }
+    cv_.notify_all();
+  }
+  int started() const { return started_.load(); }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool open_ = false;
+  std::atomic<int> started_{0};
+};
+
+cv::Mat imageOf(int value) { return cv::Mat(4, 4, CV_8UC1, cv::Scalar(value)); }
+
+}  // namespace
+
+TEST(AsyncDetector, FramesFlowWhileTheDetectorIsBusyAndOnlyTheNewestWaits) {
+  auto gated = std::make_unique<GatedDetector>();
+  GatedDetector* gate = gated.get();
+  AsyncDetector async(std::move(gated));
+  async.offer(imageOf(0), 0, 0.0);
+  while (gate->started() < 1) std::this_thread::yield();  // frame 0 is being detected
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 1; i < 50; ++i) async.offer(imageOf(i), i, i / 30.0);  // never blocks
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
+  EXPECT_FALSE(async.newest().has_value());  // boxes withheld: nothing to use yet
+  gate->open();
+  async.waitIdle();
+  const AsyncDetectionCounts c = async.counts();
+  EXPECT_EQ(c.offered, 50);
+  EXPECT_EQ(c.detected, 2);  // the frame taken first, then the newest one: no backlog
+  EXPECT_EQ(c.replaced, 48);
+  ASSERT_TRUE(async.newest().has_value());
+  EXPECT_EQ(async.newest()->frame, 49);
+  EXPECT_FLOAT_EQ(async.newest()->boxes.at(0).rect.x, 49.f);
+}
+
+TEST(BoxFeed, AResultServesOneFrameAndExpires) {
+  BoxFeed feed(0.2);
+  DetectionResult r;
+  r.frame = 3;
+  r.stamp = 1.0;
+  r.boxes.resize(1);
+  FrameBoxes a = feed.take(r, 1.05);
+  EXPECT_TRUE(a.fresh);
+  EXPECT_EQ(a.boxes.size(), 1u);
+  EXPECT_NEAR(a.age_s, 0.05, 1e-9);
+  // The same result again: no fresh boxes (the tracker carries them).
+  EXPECT_FALSE(feed.take(r, 1.08).fresh);
+  EXPECT_FALSE(feed.take(std::nullopt, 1.1).fresh);
+  // A newer result that is already too old is not used.
+  r.frame = 4;
+  r.stamp = 1.1;
+  const FrameBoxes old = feed.take(r, 1.5);
+  EXPECT_FALSE(old.fresh);
+  EXPECT_TRUE(old.boxes.empty());
+  EXPECT_EQ(feed.expired(), 1);
+}
+
+TEST(AsyncDetectionOptions, LoadsAndRejectsNegativeAge) {
+  const AsyncDetectionOptions d = AsyncDetectionOptions::load(Config());
+  EXPECT_TRUE(d.enabled);
+  EXPECT_DOUBLE_EQ(d.max_age_s, 0.2);
+  const AsyncDetectionOptions o =
+      AsyncDetectionOptions::load(Config::fromString("Detection.async: 0\nDetection.maxAge: 0.5\n"));
+  EXPECT_FALSE(o.enabled);
+  EXPECT_DOUBLE_EQ(o.max_age_s, 0.5);
+  EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.maxAge: -1\n", "bad.yaml")), Error);
+}
