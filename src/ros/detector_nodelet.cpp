@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "nodelet_common.h"
+#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
@@ -28,16 +29,22 @@ class DetectorNodelet : public nodelet::Nodelet {
     pnh.param("enabled", enabled_, true);
     std::string model;
     pnh.param<std::string>("model", model, "");
+    // Asynchronous detection (Detection.async): an input queue of one, so the detector always
+    // takes the newest image when it is free and never works through a backlog.
+    int input_queue = queue_size;
     if (enabled_) {
       try {
-        detection::DetectorOptions opt = detection::DetectorOptions::load(loadSettings(pnh));
+        const Config cfg = loadSettings(pnh);
+        if (detection::AsyncDetectionOptions::load(cfg).enabled) input_queue = 1;
+        detection::DetectorOptions opt = detection::DetectorOptions::load(cfg);
         if (!model.empty()) opt.model = model;
         double conf = -1;
         if (pnh.getParam("conf_threshold", conf)) opt.conf_threshold = static_cast<float>(conf);
         int threads = 0;
         if (pnh.getParam("threads", threads)) opt.threads = threads;
         detector_ = detection::makeDetector(opt);
-        NODELET_INFO("Detector: %s", detector_->description().c_str());
+        NODELET_INFO("Detector: %s; input queue %d (%s)", detector_->description().c_str(), input_queue,
+                     input_queue == 1 ? "newest image when free" : "every image");
       } catch (const std::exception& e) {
         // Without a detector the graph still runs (boxes stay empty, screening finds nothing).
         NODELET_ERROR("Detector: cannot load the model: %s. Publishing empty boxes; fix ~model "
@@ -45,7 +52,7 @@ class DetectorNodelet : public nodelet::Nodelet {
       }
     }
     pub_ = nh.advertise<BoundingBoxes>("yolo_slam/boxes", queue_size);
-    sub_ = nh.subscribe("camera/rgb/image_color", queue_size, &DetectorNodelet::onImage, this,
+    sub_ = nh.subscribe("camera/rgb/image_color", input_queue, &DetectorNodelet::onImage, this,
                         ::ros::TransportHints().tcpNoDelay());
     stats_timer_ = nh.createWallTimer(::ros::WallDuration(10.0), [this](const ::ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(stats_mutex_);

@@ -1,7 +1,12 @@
-// yolo_slam/Screening: pairs colour, depth and boxes by stamp (message_filters approximate
-// time), extracts ORB features, marks dynamic keypoints with depth-RANSAC inside the person
-// boxes and publishes one KeypointFrame per RGB-D pair. Frames the synchroniser drops are
-// counted (never silent): a warning per drop burst and a /diagnostics status every second.
+// yolo_slam/Screening: pairs colour and depth by stamp (message_filters approximate time),
+// extracts ORB features, marks dynamic keypoints with depth-RANSAC inside the person boxes and
+// publishes one KeypointFrame per RGB-D pair. Boxes are asynchronous by default
+// (Detection.async): a frame never waits for its own detection, it takes the newest boxes
+// message not used before if it is at most Detection.maxAge older than the frame, and the box
+// tracker carries boxes in between. With Detection.async 0 colour, depth and boxes are
+// synchronised (every frame waits for its detection, the paper's pipeline). Frames the
+// synchroniser drops are counted (never silent): a warning per drop burst and a /diagnostics
+// status every second.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
@@ -12,15 +17,18 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
+#include <atomic>
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "nodelet_common.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/ros/conversions.h"
 
@@ -55,9 +63,14 @@ class ScreeningNodelet : public nodelet::Nodelet {
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
       if (!use_boxes_) sopt.track_boxes = false;
       front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
+      const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
+      async_boxes_ = use_boxes_ && aopt.enabled;
+      box_feed_ = std::make_unique<detection::BoxFeed>(aopt.max_age_s);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
                    front_end_->extractor().options().n_features, screening::toString(sopt.mode).c_str(),
-                   use_boxes_ ? "rgb+depth+boxes" : "rgb+depth (no detector)", queue_size);
+                   !use_boxes_ ? "rgb+depth (no detector)"
+                   : async_boxes_ ? "rgb+depth, newest boxes (async)" : "rgb+depth+boxes synchronised",
+                   queue_size);
     } catch (const std::exception& e) {
       NODELET_ERROR("Screening: bad settings: %s. The nodelet is idle until restarted with "
                     "valid ~settings", e.what());
@@ -71,7 +84,11 @@ class ScreeningNodelet : public nodelet::Nodelet {
     rgb_sub_.subscribe(nh, "camera/rgb/image_color", queue_size);
     depth_sub_.subscribe(nh, "camera/depth/image", queue_size);
     rgb_sub_.registerCallback(&ScreeningNodelet::onRgbArrived, this);
-    if (use_boxes_) {
+    if (async_boxes_) {
+      // Multi-threaded handle: boxes are stored while a frame is being processed.
+      async_boxes_sub_ = getMTNodeHandle().subscribe("yolo_slam/boxes", kBoxesQueue, &ScreeningNodelet::onBoxes, this);
+    }
+    if (use_boxes_ && !async_boxes_) {
       boxes_sub_.subscribe(nh, "yolo_slam/boxes", queue_size);
       sync3_ = std::make_unique<Sync3>(sp::ApproximateTime<Image, Image, BoundingBoxes>(queue_size),
                                        rgb_sub_, depth_sub_, boxes_sub_);
@@ -105,6 +122,29 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   void onFrame2(const ImageConstPtr& rgb, const ImageConstPtr& depth) {
     process(rgb, depth, nullptr);
+  }
+  void onBoxes(const BoundingBoxes::ConstPtr& msg) {
+    detection::DetectionResult r;
+    r.stamp = msg->header.stamp.toSec();
+    r.boxes = boxesFromMsg(msg->boxes);
+    std::lock_guard<std::mutex> lock(boxes_mutex_);
+    r.frame = ++boxes_received_;
+    newest_boxes_ = std::move(r);
+  }
+  // The boxes of a frame: synchronised ones, or the newest asynchronous result if fresh.
+  detection::Boxes boxesFor(const ::ros::Time& stamp, const BoundingBoxes::ConstPtr& synced) {
+    if (synced) return boxesFromMsg(synced->boxes);
+    if (!async_boxes_) return {};
+    std::optional<detection::DetectionResult> newest;
+    {
+      std::lock_guard<std::mutex> lock(boxes_mutex_);
+      newest = newest_boxes_;
+    }
+    const long expired_before = box_feed_->expired();
+    detection::FrameBoxes fb = box_feed_->take(newest, stamp.toSec());
+    boxes_too_old_ += box_feed_->expired() - expired_before;
+    if (fb.fresh) ++frames_with_new_boxes_;
+    return std::move(fb.boxes);
   }
   void onFrame3(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                 const BoundingBoxes::ConstPtr& boxes) {
@@ -146,8 +186,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
                     std::to_string(image.rows) + " differs from the calibration (" +
                     std::to_string(cam.width) + "x" + std::to_string(cam.height) + ")");
       cam.rgb_order = is_rgb;
-      detection::Boxes boxes;
-      if (boxes_msg) boxes = boxesFromMsg(boxes_msg->boxes);
+      const detection::Boxes boxes = boxesFor(rgb->header.stamp, boxes_msg);
       const frontend::FrontEndResult fe =
           front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes, cam);
       auto out = boost::make_shared<KeypointFrame>();
@@ -159,7 +198,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++published_;
       ms_.push_back(sw.ms());
-      if (ms_.size() > 1000) ms_.erase(ms_.begin(), ms_.begin() + 500);
+      extraction_ms_.push_back(fe.stats.extraction_ms);
+      screening_ms_.push_back(fe.stats.screening_ms);
+      for (auto* v : {&ms_, &extraction_ms_, &screening_ms_})
+        if (v->size() > kTimingWindow) v->erase(v->begin(), v->begin() + kTimingWindow / 2);
     } catch (const std::exception& e) {
       ++rejected_;
       if (throttle_.shouldLog(e.what()))
@@ -171,11 +213,13 @@ class ScreeningNodelet : public nodelet::Nodelet {
     diagnostic_msgs::DiagnosticStatus st;
     st.name = getName() + ": frames";
     st.hardware_id = "yolo_slam";
-    Summary s;
+    Summary s, ext, scr;
     size_t rgb = 0, synced = 0, published = 0;
     {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       s = summarize(ms_);
+      ext = summarize(extraction_ms_);
+      scr = summarize(screening_ms_);
       rgb = rgb_received_;
       synced = synced_;
       published = published_;
@@ -198,13 +242,36 @@ class ScreeningNodelet : public nodelet::Nodelet {
     kv("dropped_by_sync", std::to_string(dropped));
     kv("rejected_bad_input", std::to_string(rejected));
     kv("median_ms", std::to_string(s.median));
+    kv("extraction_median_ms", std::to_string(ext.median));
+    kv("screening_median_ms", std::to_string(scr.median));
+    kv("boxes", !use_boxes_ ? "none" : async_boxes_ ? "async" : "synchronised");
+    if (async_boxes_) {
+      kv("boxes_received", std::to_string(boxesReceived()));
+      kv("frames_with_new_boxes", std::to_string(frames_with_new_boxes_.load()));
+      kv("boxes_too_old", std::to_string(boxes_too_old_.load()));
+    }
     diagnostic_msgs::DiagnosticArray arr;
     arr.header.stamp = ::ros::Time::now();
     arr.status.push_back(st);
     diag_pub_.publish(arr);
   }
 
+  long boxesReceived() {
+    std::lock_guard<std::mutex> lock(boxes_mutex_);
+    return boxes_received_;
+  }
+
+  static constexpr int kBoxesQueue = 5;             // boxes are small; a few in flight
+  static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
+  bool async_boxes_ = true;  // set in onInit
+  // The newest boxes message (boxes callback vs frame callback).
+  std::mutex boxes_mutex_;  // guards newest_boxes_, boxes_received_
+  std::optional<detection::DetectionResult> newest_boxes_;
+  long boxes_received_ = 0;
+  // Which result each frame gets (frame callback only, serialised by the synchroniser).
+  std::unique_ptr<detection::BoxFeed> box_feed_;
+  std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
   // Extraction and screening (stateful between frames; used by the frame callback only, which
@@ -213,10 +280,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
-  std::mutex stats_mutex_;  // guards the counters below, pending_rgb_ and ms_
+  std::mutex stats_mutex_;  // guards the counters below, pending_rgb_ and the timing samples
   size_t rgb_received_ = 0, synced_ = 0, published_ = 0;
   std::deque<::ros::Time> pending_rgb_;
-  std::vector<double> ms_;
+  std::vector<double> ms_, extraction_ms_, screening_ms_;
   std::atomic<size_t> dropped_{0}, rejected_{0};
   uint32_t index_ = 0;  // frame callback only (the synchroniser serialises it)
 
@@ -224,7 +291,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
   message_filters::Subscriber<BoundingBoxes> boxes_sub_;
   std::unique_ptr<Sync3> sync3_;
   std::unique_ptr<Sync2> sync2_;
-  ::ros::Subscriber info_sub_;
+  ::ros::Subscriber info_sub_, async_boxes_sub_;
   ::ros::Publisher pub_, diag_pub_;
   ::ros::WallTimer diag_timer_;
 };

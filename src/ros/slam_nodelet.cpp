@@ -210,12 +210,21 @@ class SlamNodelet : public nodelet::Nodelet {
     if (res.state == slam::TrackingState::Ok) {
       ++tracked_;
       publishPose(*msg, res.T_wc);
+      recordLatency(msg->header.stamp);
     } else {
       ++not_tracked_;
       NODELET_WARN_THROTTLE(2.0, "Slam: tracking %s at %.3f (%d inliers)", stateName(res.state),
                             msg->header.stamp.toSec(), res.inliers);
     }
     if (debug_image_ && debug_pub_.getNumSubscribers() > 0) publishDebug(*msg, res);
+  }
+
+  // Image stamp to published pose, in the ROS clock (sim time when a bag plays with --clock).
+  void recordLatency(const ::ros::Time& stamp) {
+    const double ms = (::ros::Time::now() - stamp).toSec() * 1000.0;
+    std::lock_guard<std::mutex> lock(latency_mutex_);
+    latency_ms_.push_back(ms);
+    if (latency_ms_.size() > kLatencyWindow) latency_ms_.erase(latency_ms_.begin(), latency_ms_.begin() + kLatencyWindow / 2);
   }
 
   // Camera pose in the SLAM world (first camera frame) -> base_link pose in the map frame
@@ -446,6 +455,17 @@ class SlamNodelet : public nodelet::Nodelet {
     m.key = "track_median_ms";
     m.value = std::to_string(s.median);
     st.values.push_back(m);
+    Summary lat;
+    {
+      std::lock_guard<std::mutex> lock(latency_mutex_);
+      lat = summarize(latency_ms_);
+    }
+    for (const auto& kvp : {std::make_pair("latency_median_ms", lat.median), std::make_pair("latency_p95_ms", lat.p95)}) {
+      diagnostic_msgs::KeyValue l;
+      l.key = kvp.first;
+      l.value = std::to_string(kvp.second);
+      st.values.push_back(l);
+    }
     diagnostic_msgs::DiagnosticArray arr;
     arr.header.stamp = ::ros::Time::now();
     arr.status.push_back(st);
@@ -531,6 +551,10 @@ class SlamNodelet : public nodelet::Nodelet {
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
   std::atomic<size_t> received_{0}, tracked_{0}, not_tracked_{0}, dropped_{0}, rejected_{0};
+  // Image stamp to pose, the last kLatencyWindow frames (frame callback vs diagnostics timer).
+  static constexpr size_t kLatencyWindow = 2000;
+  std::mutex latency_mutex_;  // guards latency_ms_
+  std::vector<double> latency_ms_;
   std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
 
   ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;

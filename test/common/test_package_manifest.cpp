@@ -86,10 +86,11 @@ const std::set<std::string> kIncludeNoKey = {"sys", "yolo_slam"};
 // Python modules imported by scripts and benchmarks that need a key; the standard library needs none.
 const std::map<std::string, std::string> kPythonKey = {
     {"rospy", "rospy"}, {"rosbag", "rosbag"}, {"tf2_msgs", "tf2_msgs"}, {"cv2", "python3-opencv"},
-    {"numpy", "python3-numpy"}, {"sensor_msgs", "sensor_msgs"}, {"geometry_msgs", "geometry_msgs"}};
+    {"numpy", "python3-numpy"}, {"sensor_msgs", "sensor_msgs"}, {"geometry_msgs", "geometry_msgs"},
+    {"diagnostic_msgs", "diagnostic_msgs"}};
 const std::set<std::string> kPythonStdlib = {"argparse", "collections", "json", "math", "os", "re",
                                              "statistics", "sys", "xml", "subprocess", "time", "glob",
-                                             "shutil", "struct", "tempfile", "itertools", "functools"};
+                                             "shutil", "struct", "tempfile", "itertools", "functools", "signal"};
 // Keys a build needs without an include of their own.
 const std::set<std::string> kBuildOnlyKeys = {"catkin", "message_generation", "message_runtime"};
 

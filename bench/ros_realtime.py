@@ -1,0 +1,114 @@
+#!/usr/bin/python3
+"""The ROS graph against a bag played at rate 1, as on a robot: how many frames get a pose,
+the latency from image stamp to published pose, frames dropped, and the ATE.
+
+usage: bench/ros_realtime.py SEQ_DIR [--bag BAG] [--rate 1.0] [--out DIR] [--launch-arg k:=v ...]
+
+SEQ_DIR is a TUM folder with groundtruth.txt (yolo_slam_synth output); the bag is made from it
+with scripts/tum_to_bag.py unless --bag names one. Runs `roslaunch yolo_slam tum_bag.launch`
+(source build/ws/devel/setup.bash first), reads /diagnostics until playback has ended and the
+graph has drained, saves the trajectory through /yolo_slam/save_trajectory and evaluates it
+with yolo_slam_eval. Prints one JSON object (also written to OUT/ros_realtime.json).
+"""
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import rospy
+from diagnostic_msgs.msg import DiagnosticArray
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+BIN = os.path.join(REPO, "build", "ws", "devel", "lib", "yolo_slam")
+START_DELAY_S = 3.0   # tum_bag.launch's start_delay
+DRAIN_QUIET_S = 5.0   # the graph has drained when the Slam nodelet received nothing for this long
+
+
+def frames_in(seq):
+    with open(os.path.join(seq, "associations.txt")) as f:
+        return sum(1 for line in f if line.strip() and not line.startswith("#"))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("seq")
+    ap.add_argument("--bag")
+    ap.add_argument("--rate", type=float, default=1.0)
+    ap.add_argument("--out", default="/tmp/yolo_slam_ros_realtime")
+    ap.add_argument("--launch-arg", action="append", default=[])
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    bag = a.bag or os.path.join(a.out, "sequence.bag")
+    if not a.bag and not os.path.exists(bag):
+        subprocess.check_call([os.path.join(REPO, "scripts", "tum_to_bag.py"), a.seq, bag])
+    frames = frames_in(a.seq)
+    traj = os.path.join(a.out, "CameraTrajectory.txt")
+    if os.path.exists(traj):
+        os.remove(traj)
+
+    launch = subprocess.Popen(["roslaunch", "yolo_slam", "tum_bag.launch", "bag:=" + bag, "rate:=%g" % a.rate,
+                               "trajectory_path:=" + traj] + a.launch_arg,
+                              stdout=open(os.path.join(a.out, "launch.log"), "w"), stderr=subprocess.STDOUT,
+                              preexec_fn=os.setsid)
+    diag = {}
+
+    def on_diag(msg):
+        for st in msg.status:
+            diag[st.name] = {kv.key: kv.value for kv in st.values}
+
+    def slam_diag():
+        return next((v for k, v in diag.items() if "slam" in k and "tracking" in k), {})
+
+    try:
+        time.sleep(2.0)  # the master
+        rospy.init_node("ros_realtime_bench", anonymous=True, disable_signals=True)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag)
+        play_s = frames / 30.0 / a.rate
+        deadline = time.time() + 60 + START_DELAY_S + play_s * 3
+        last_received, last_change = -1, time.time()
+        while time.time() < deadline:
+            time.sleep(0.5)
+            received = int(slam_diag().get("received", "0"))
+            if received != last_received:
+                last_received, last_change = received, time.time()
+            elif received > 0 and time.time() - last_change > DRAIN_QUIET_S:
+                break
+        time.sleep(1.5)  # one more diagnostics round
+        subprocess.call(["rosservice", "call", "/yolo_slam/save_trajectory", "path: '%s'" % traj],
+                        stdout=subprocess.DEVNULL)
+    finally:
+        os.killpg(os.getpgid(launch.pid), signal.SIGINT)
+        try:
+            launch.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(os.getpgid(launch.pid), signal.SIGKILL)
+
+    s = slam_diag()
+    scr = next((v for k, v in diag.items() if "screening" in k), {})
+    poses = sum(1 for line in open(traj) if line.strip() and not line.startswith("#")) if os.path.exists(traj) else 0
+    ate = None
+    if poses >= 2:
+        out = subprocess.run([os.path.join(BIN, "yolo_slam_eval"), "ate", os.path.join(a.seq, "groundtruth.txt"),
+                              traj, "--json"], capture_output=True, text=True)
+        if out.returncode == 0:
+            ate = json.loads(out.stdout).get("rmse")
+    result = {
+        "frames": frames, "rate": a.rate, "poses": poses,
+        "posed_fraction": round(poses / frames, 4) if frames else None,
+        "latency_median_ms": float(s.get("latency_median_ms", "nan")),
+        "latency_p95_ms": float(s.get("latency_p95_ms", "nan")),
+        "slam": s, "screening": scr, "ate_rmse_m": ate,
+        "load": open("/proc/loadavg").read().split()[:3],
+    }
+    with open(os.path.join(a.out, "ros_realtime.json"), "w") as f:
+        json.dump(result, f, indent=2)
+    print(json.dumps(result, indent=2))
+    return 0 if poses > 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
