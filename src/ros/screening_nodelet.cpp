@@ -57,7 +57,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       std::string mode;
       if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
-      if (!use_boxes_) sopt.track_boxes = false;
+      if (!use_boxes_) sopt.tracker.enabled = false;
       screening_ = std::make_unique<screening::ScreeningPipeline>(sopt);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
                    orb_->options().n_features, screening::toString(sopt.mode).c_str(),

@@ -1,10 +1,9 @@
 #include "yolo_slam/screening/screener.h"
-#include "yolo_slam/screening/box_tracker.h"
 #include "yolo_slam/screening/flat_box.h"
-#include "yolo_slam/screening/temporal.h"
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -14,143 +13,84 @@
 #include <cmath>
 #include <limits>
 #include <random>
-#include <sstream>
 
 namespace yolo_slam {
 namespace screening {
 
-DynamicMode parseDynamicMode(const std::string& s) {
-  if (s == "off") return DynamicMode::Off;
-  if (s == "detect") return DynamicMode::Detect;
-  if (s == "geometry") return DynamicMode::Geometry;
-  if (s == "detect+geometry") return DynamicMode::DetectGeometry;
-  throw Error("unknown dynamic mode '" + s +
-              "'; use one of off, detect, geometry, detect+geometry");
+namespace {
+
+const EnumNames<DynamicMode>& modeNames() {
+  using M = DynamicMode;
+  static const EnumNames<M> names = {{"off", M::Off}, {"detect", M::Detect},
+                                     {"geometry", M::Geometry}, {"detect+geometry", M::DetectGeometry}};
+  return names;
 }
 
-std::string toString(DynamicMode m) {
-  switch (m) {
-    case DynamicMode::Off: return "off";
-    case DynamicMode::Detect: return "detect";
-    case DynamicMode::Geometry: return "geometry";
-    case DynamicMode::DetectGeometry: return "detect+geometry";
-  }
-  return "?";
+const EnumNames<ScreeningVariant>& variantNames() {
+  using V = ScreeningVariant;
+  static const EnumNames<V> names = {{"paper", V::Paper}, {"grow", V::Grow}, {"nearest", V::Nearest}};
+  return names;
 }
+
+const EnumNames<ScreeningOptions::NoDepthRule>& noDepthNames() {
+  using R = ScreeningOptions::NoDepthRule;
+  static const EnumNames<R> names = {{"dynamic", R::Dynamic}, {"static", R::Static},
+                                     {"nearest", R::Nearest}, {"near-dynamic", R::NearDynamic}};
+  return names;
+}
+
+const OptionTable<ScreeningOptions>& screeningFields() {
+  using O = ScreeningOptions;
+  static const OptionTable<O> table = {
+      {"Screening.varianceThreshold", &O::variance_threshold_m2, Range::positive()},
+      {"Screening.probability", &O::probability, Range::open(0, 1)},
+      {"Screening.maxIterations", &O::max_iterations, Range::atLeast(1)},
+      {"Screening.seed", &O::seed, Range::atLeast(0)},
+      {"Screening.boxDilation", &O::box_dilation, Range::closed(0, 1)},
+      {"Screening.growRadius", &O::grow_radius_px, Range::positive()},
+      {"Screening.growDepth", &O::grow_depth_m, Range::positive()},
+      {"Screening.clusterMinFraction", &O::cluster_min_fraction, Range::fraction()},
+      {"Screening.noDepthRadius", &O::no_depth_radius_px, Range::positive()},
+      {"Screening.silhouetteRadius", &O::silhouette_radius_px, Range::atLeast(0)},
+      {"Screening.dilationDepthOnly", &O::dilation_depth_only},
+      {"Screening.rejectFlatBoxes", &O::reject_flat_boxes},
+      {"Screening.flatBoxFraction", &O::flat_box_fraction, Range::fraction()},
+      {"Screening.flatBoxTolerance", &O::flat_box_tolerance, Range::positive()},
+      {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
+  };
+  return table;
+}
+
+}  // namespace
+
+DynamicMode parseDynamicMode(const std::string& s) {
+  if (const DynamicMode* m = findEnum(modeNames(), s)) return *m;
+  throw Error("unknown dynamic mode '" + s + "'; use one of " + listNames(modeNames()));
+}
+
+std::string toString(DynamicMode m) { return nameOf(modeNames(), m); }
 
 ScreeningVariant parseScreeningVariant(const std::string& s) {
-  if (s == "paper") return ScreeningVariant::Paper;
-  if (s == "grow") return ScreeningVariant::Grow;
-  if (s == "nearest") return ScreeningVariant::Nearest;
-  throw Error("unknown screening variant '" + s + "'; use paper, grow or nearest");
+  if (const ScreeningVariant* v = findEnum(variantNames(), s)) return *v;
+  throw Error("unknown screening variant '" + s + "'; use one of " + listNames(variantNames()));
 }
 
-std::string toString(ScreeningVariant v) {
-  switch (v) {
-    case ScreeningVariant::Paper: return "paper";
-    case ScreeningVariant::Grow: return "grow";
-    case ScreeningVariant::Nearest: return "nearest";
-  }
-  return "?";
-}
+std::string toString(ScreeningVariant v) { return nameOf(variantNames(), v); }
 
 void ScreeningOptions::validate(const std::string& where) const {
-  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
-  if (!(variance_threshold_m2 > 0) || !std::isfinite(variance_threshold_m2))
-    bad("variance threshold must be > 0 (m^2), got " + std::to_string(variance_threshold_m2));
-  if (!(probability > 0 && probability < 1))
-    bad("probability must be in (0, 1), got " + std::to_string(probability));
-  if (max_iterations < 1) bad("maxIterations must be >= 1, got " + std::to_string(max_iterations));
-  if (!(box_dilation >= 0 && box_dilation <= 1))
-    bad("boxDilation must be in [0, 1], got " + std::to_string(box_dilation));
-  if (!(grow_radius_px > 0) || !std::isfinite(grow_radius_px))
-    bad("growRadius must be > 0 (pixels), got " + std::to_string(grow_radius_px));
-  if (!(grow_depth_m > 0) || !std::isfinite(grow_depth_m))
-    bad("growDepth must be > 0 (metres), got " + std::to_string(grow_depth_m));
-  if (!(cluster_min_fraction > 0 && cluster_min_fraction <= 1))
-    bad("clusterMinFraction must be in (0, 1], got " + std::to_string(cluster_min_fraction));
-  if (!(no_depth_radius_px > 0) || !std::isfinite(no_depth_radius_px))
-    bad("noDepthRadius must be > 0 (pixels), got " + std::to_string(no_depth_radius_px));
-  if (!(silhouette_radius_px >= 0) || !std::isfinite(silhouette_radius_px))
-    bad("silhouetteRadius must be >= 0 (pixels; 0 = off), got " + std::to_string(silhouette_radius_px));
-  if (!(flat_box_fraction > 0 && flat_box_fraction <= 1))
-    bad("flatBoxFraction must be in (0, 1], got " + std::to_string(flat_box_fraction));
-  if (!(flat_box_tolerance > 0) || !std::isfinite(flat_box_tolerance))
-    bad("flatBoxTolerance must be > 0 (1/m, inverse depth), got " + std::to_string(flat_box_tolerance));
-  if (!(flat_box_ring > 0 && flat_box_ring <= 2))
-    bad("flatBoxRing must be in (0, 2] (fraction of the box size), got " + std::to_string(flat_box_ring));
-  // The tracker's and the temporal evidence's own checks, with the same key names.
-  BoxTrackerOptions::from(*this).validate(where);
-  TemporalOptions::from(*this).validate(where);
+  checkOptions(*this, where, screeningFields());
+  tracker.validate(where);
+  temporal.validate(where);
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   ScreeningOptions o;
-  const std::string file = cfg.path().empty() ? std::string("<config>") : cfg.path();
-  auto rethrow = [&](const std::string& key, const Error& e) {
-    throw Error(file + ": key '" + key + "': " + e.what());
-  };
-  try {
-    o.mode = parseDynamicMode(cfg.getString("Screening.mode", toString(o.mode)));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind(file, 0) == 0) throw;
-    rethrow("Screening.mode", e);
-  }
-  try {
-    o.variant = parseScreeningVariant(cfg.getString("Screening.variant", toString(o.variant)));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind(file, 0) == 0) throw;
-    rethrow("Screening.variant", e);
-  }
-  o.variance_threshold_m2 = cfg.getDouble("Screening.varianceThreshold", o.variance_threshold_m2);
-  o.probability = cfg.getDouble("Screening.probability", o.probability);
-  o.max_iterations = cfg.getInt("Screening.maxIterations", o.max_iterations);
-  int seed = cfg.getInt("Screening.seed", static_cast<int>(o.seed));
-  if (seed < 0) throw Error(file + ": key 'Screening.seed' must be >= 0, got " + std::to_string(seed));
-  o.seed = static_cast<unsigned>(seed);
-  static const char* const kNoDepthNames[] = {"dynamic", "static", "nearest", "near-dynamic"};
-  std::string nd = cfg.getString("Screening.noDepth", kNoDepthNames[static_cast<int>(o.no_depth)]);
-  if (nd == "dynamic") {
-    o.no_depth = NoDepthRule::Dynamic;
-  } else if (nd == "static") {
-    o.no_depth = NoDepthRule::Static;
-  } else if (nd == "nearest") {
-    o.no_depth = NoDepthRule::Nearest;
-  } else if (nd == "near-dynamic") {
-    o.no_depth = NoDepthRule::NearDynamic;
-  } else {
-    throw Error(file + ": key 'Screening.noDepth' must be dynamic, static, nearest or near-dynamic, got '" + nd + "'");
-  }
-  o.box_dilation = cfg.getDouble("Screening.boxDilation", o.box_dilation);
-  o.grow_radius_px = cfg.getDouble("Screening.growRadius", o.grow_radius_px);
-  o.grow_depth_m = cfg.getDouble("Screening.growDepth", o.grow_depth_m);
-  o.cluster_min_fraction = cfg.getDouble("Screening.clusterMinFraction", o.cluster_min_fraction);
-  o.no_depth_radius_px = cfg.getDouble("Screening.noDepthRadius", o.no_depth_radius_px);
-  o.silhouette_radius_px = cfg.getDouble("Screening.silhouetteRadius", o.silhouette_radius_px);
-  o.dilation_depth_only = cfg.getBool("Screening.dilationDepthOnly", o.dilation_depth_only);
-  o.reject_flat_boxes = cfg.getBool("Screening.rejectFlatBoxes", o.reject_flat_boxes);
-  o.flat_box_fraction = cfg.getDouble("Screening.flatBoxFraction", o.flat_box_fraction);
-  o.flat_box_tolerance = cfg.getDouble("Screening.flatBoxTolerance", o.flat_box_tolerance);
-  o.flat_box_ring = cfg.getDouble("Screening.flatBoxRing", o.flat_box_ring);
-  o.track_boxes = cfg.getBool("Screening.trackBoxes", o.track_boxes);
-  o.track_max_age = cfg.getInt("Screening.trackMaxAge", o.track_max_age);
-  o.track_radius_px = cfg.getDouble("Screening.trackRadius", o.track_radius_px);
-  o.track_max_hamming = cfg.getInt("Screening.trackMaxHamming", o.track_max_hamming);
-  o.track_min_matches = cfg.getInt("Screening.trackMinMatches", o.track_min_matches);
-  o.track_min_score = cfg.getDouble("Screening.trackMinScore", o.track_min_score);
-  o.propagate_labels = cfg.getBool("Screening.propagateLabels", o.propagate_labels);
-  o.propagate_max_age = cfg.getInt("Screening.propagateMaxAge", o.propagate_max_age);
-  o.static_box_veto = cfg.getBool("Screening.staticBoxVeto", o.static_box_veto);
-  o.static_box_fraction = cfg.getDouble("Screening.staticBoxFraction", o.static_box_fraction);
-  o.static_box_min_points = cfg.getInt("Screening.staticBoxMinPoints", o.static_box_min_points);
-  o.static_box_max_score = cfg.getDouble("Screening.staticBoxMaxScore", o.static_box_max_score);
-  o.temporal_radius_px = cfg.getDouble("Screening.temporalRadius", o.temporal_radius_px);
-  o.temporal_max_hamming = cfg.getInt("Screening.temporalMaxHamming", o.temporal_max_hamming);
-  o.temporal_max_depth_change_m =
-      cfg.getDouble("Screening.temporalMaxDepthChange", o.temporal_max_depth_change_m);
-  o.temporal_static_tolerance_px =
-      cfg.getDouble("Screening.temporalStaticTolerance", o.temporal_static_tolerance_px);
-  o.validate(file + ": Screening.*");
+  o.mode = readEnum(cfg, "Screening.mode", o.mode, modeNames());
+  o.variant = readEnum(cfg, "Screening.variant", o.variant, variantNames());
+  o.no_depth = readEnum(cfg, "Screening.noDepth", o.no_depth, noDepthNames());
+  readOptions(cfg, o, screeningFields());
+  o.tracker = BoxTrackerOptions::load(cfg);
+  o.temporal = TemporalOptions::load(cfg);
   return o;
 }
 
