@@ -223,178 +223,220 @@ bool inside(const cv::Rect2f& r, const cv::Point2f& p) {
   return p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height;
 }
 
-ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
-                                const cv::Mat& depth_m) const {
-  Stopwatch sw;
-  ScreeningStats st;
+namespace {
+
+// One RANSAC region of screen(): a dilated box, or the whole image in geometry mode. The
+// buffers are reused from region to region.
+struct Region {
+  unsigned index = 0;                // the box's index (0 in geometry mode); seeds the RNG
+  const cv::Rect2f* box = nullptr;   // the dilated box; null in geometry mode
+  const cv::Rect2f* core = nullptr;  // the detected box when dilation_depth_only, else null
+  std::vector<int> idx;              // every keypoint of the region
+  // Of those, the keypoints with depth, their depths and positions, and which of them are
+  // the person (set by findPerson).
+  std::vector<int> with_depth;
+  std::vector<float> depths;
+  std::vector<cv::Point2f> pts;
+  std::vector<uint8_t> member;
+};
+
+// The depth image for the silhouette rule, empty when the rule is off; throws unless it is
+// CV_32FC1 of the frame's size.
+cv::Mat silhouetteDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
+                        const cv::Mat& depth_m) {
+  if (o.silhouette_radius_px <= 0 || depth_m.empty()) return cv::Mat();
+  if (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height)
+    throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of "
+                "the frame's size (" + std::to_string(frame.width) + "x" +
+                std::to_string(frame.height) + ")");
+  return depth_m;
+}
+
+// The modes with geometry need a depth per keypoint.
+void checkDepths(const ScreeningOptions& o, const features::FeatureFrame& frame) {
   const size_t n = frame.keypoints.size();
-  if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
-  if (frame.depth.size() != n && opt_.mode != DynamicMode::Off && opt_.mode != DynamicMode::Detect) {
+  if (frame.depth.size() != n && o.mode != DynamicMode::Off && o.mode != DynamicMode::Detect) {
     throw Error("screening: frame has " + std::to_string(n) + " keypoints but " +
                 std::to_string(frame.depth.size()) + " depths; build it with buildFeatureFrame");
   }
-  if (opt_.mode == DynamicMode::Off) {
-    st.ms = sw.ms();
-    return st;
+}
+
+// Algorithm 1 (or the nearest cluster), then the grow step, over the region's keypoints with
+// depth. Returns the RANSAC iterations.
+int findPerson(const Screener& s, const features::FeatureFrame& frame, Region& r) {
+  const ScreeningOptions& o = s.options();
+  r.depths.clear();
+  r.with_depth.clear();
+  r.pts.clear();
+  for (int i : r.idx) {
+    if (frame.depth[i] > 0) {
+      r.depths.push_back(frame.depth[i]);
+      r.with_depth.push_back(i);
+      r.pts.push_back(frame.keypoints[i].pt);
+    }
   }
-
-  std::vector<uint8_t> in_any(n, 0), drop(n, 0);
-  std::vector<int> members;
-  std::vector<float> depths;
-  members.reserve(n);
-  depths.reserve(n);
-
-  // Silhouette rule: keypoints of the region left static whose depth is missing or outside the
-  // person's range [lo, hi] (+- grow_depth_m), with a depth pixel inside it within the radius.
-  const bool silhouette = opt_.silhouette_radius_px > 0 && !depth_m.empty();
-  if (silhouette && (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height))
-    throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of the "
-                "frame's size (" + std::to_string(frame.width) + "x" + std::to_string(frame.height) + ")");
-  auto markSilhouette = [&](const std::vector<int>& idx, const std::vector<float>& dep,
-                            const std::vector<uint8_t>& mem, const cv::Rect2f& box) {
-    float lo = std::numeric_limits<float>::max(), hi = 0.f;
-    for (size_t m = 0; m < mem.size(); ++m)
-      if (mem[m]) lo = std::min(lo, dep[m]), hi = std::max(hi, dep[m]);
-    if (hi <= 0.f) return;
-    lo -= static_cast<float>(opt_.grow_depth_m);
-    hi += static_cast<float>(opt_.grow_depth_m);
-    const cv::Rect img(0, 0, depth_m.cols, depth_m.rows);
-    for (int i : idx) {
-      if (drop[i] || !inside(box, frame.keypoints[i].pt)) continue;
-      const float d = frame.depth[i];
-      if (d >= lo && d <= hi) continue;  // at the person's depth: Algorithm 1's call stands
-      const cv::KeyPoint& kp = frame.keypoints[i];
-      const int r = std::max(1, static_cast<int>(std::lround(opt_.silhouette_radius_px * kp.size / 31.f)));
-      const cv::Rect win = cv::Rect(static_cast<int>(std::lround(kp.pt.x)) - r,
-                                    static_cast<int>(std::lround(kp.pt.y)) - r, 2 * r + 1, 2 * r + 1) & img;
-      bool near_person = false;
-      for (int v = win.y; v < win.br().y && !near_person; ++v) {
-        const float* row = depth_m.ptr<float>(v);
-        for (int u = win.x; u < win.br().x; ++u)
-          if (row[u] >= lo && row[u] <= hi) {
-            near_person = true;
-            break;
-          }
-      }
-      if (near_person) {
-        drop[i] = 1;
-        ++st.silhouette;
-      }
-    }
-  };
-
-  // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + 7919 r so regions
-  // are independent of each other and of previous frames.
-  std::vector<cv::Point2f> pts;
-  std::vector<uint8_t> member;
-  // core: the detected (undilated) box when dilation_depth_only, else null. region_box: the
-  // (dilated) box of a detection for the flat-box rule, null in geometry mode.
-  auto screenRegion = [&](const std::vector<int>& idx, unsigned region, const cv::Rect2f* core,
-                          const cv::Rect2f* region_box) {
-    depths.clear();
-    members.clear();
-    pts.clear();
-    for (int i : idx) {
-      if (frame.depth[i] > 0) {
-        depths.push_back(frame.depth[i]);
-        members.push_back(i);
-        pts.push_back(frame.keypoints[i].pt);
-      }
-    }
-    member.assign(depths.size(), 0);
-    if (opt_.variant == ScreeningVariant::Nearest) {
-      for (int m : nearestCluster(depths)) member[m] = 1;
-    } else {
-      ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
-      st.iterations += r.iterations;
-      for (int m : r.members) member[m] = 1;
-    }
-    if (opt_.variant != ScreeningVariant::Paper) grow(pts, depths, member);
-    if (region_box && opt_.reject_flat_boxes) {
-      std::vector<int> cluster;
-      for (size_t m = 0; m < member.size(); ++m)
-        if (member[m]) cluster.push_back(members[m]);
-      FlatBoxOptions fo;
-      fo.ring = opt_.flat_box_ring;
-      fo.tolerance = opt_.flat_box_tolerance;
-      fo.fraction = opt_.flat_box_fraction;
-      fo.seed = opt_.seed + 7919u * region;
-      std::vector<cv::Rect2f> others;  // region is the box's index in box mode
-      for (size_t k = 0; k < boxes.size(); ++k)
-        if (k != region) others.push_back(dilate(boxes[k].rect, opt_.box_dilation));
-      if (testFlatBox(frame, *region_box, cluster, fo, others).flat) {
-        ++st.flat_boxes;
-        return;  // a picture or static surface: nothing in this box is dropped
-      }
-    }
-    for (size_t m = 0; m < member.size(); ++m)
-      if (member[m]) drop[members[m]] = 1;
-    if (region_box && silhouette) markSilhouette(idx, depths, member, *region_box);
-    if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
-    const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
-    const float nd2 = static_cast<float>(opt_.no_depth_radius_px * opt_.no_depth_radius_px);
-    for (int i : idx) {
-      if (frame.depth[i] > 0) continue;
-      if (core && !inside(*core, frame.keypoints[i].pt)) continue;  // dilation ring: depth only
-      if (opt_.no_depth == ScreeningOptions::NoDepthRule::Dynamic) {
-        drop[i] = 1;
-        continue;
-      }
-      if (opt_.no_depth == ScreeningOptions::NoDepthRule::NearDynamic) {
-        const cv::Point2f p = frame.keypoints[i].pt;
-        for (size_t m = 0; m < pts.size(); ++m) {
-          if (!member[m]) continue;
-          const float dx = pts[m].x - p.x, dy = pts[m].y - p.y;
-          if (dx * dx + dy * dy < nd2) {
-            drop[i] = 1;
-            break;
-          }
-        }
-        continue;
-      }
-      // Nearest: copy the label of the closest keypoint with depth within the radius.
-      const cv::Point2f p = frame.keypoints[i].pt;
-      float best = r2;
-      int label = 0;
-      for (size_t m = 0; m < pts.size(); ++m) {
-        const float dx = pts[m].x - p.x, dy = pts[m].y - p.y, d2 = dx * dx + dy * dy;
-        if (d2 < best) {
-          best = d2;
-          label = member[m];
-        }
-      }
-      if (label) drop[i] = 1;
-    }
-  };
-
-  std::vector<int> idx;
-  idx.reserve(n);
-  if (opt_.mode == DynamicMode::Geometry) {
-    // The whole image is one box.
-    for (size_t i = 0; i < n; ++i) idx.push_back(static_cast<int>(i));
-    std::fill(in_any.begin(), in_any.end(), 1);
-    screenRegion(idx, 0, nullptr, nullptr);
+  r.member.assign(r.depths.size(), 0);
+  int iterations = 0;
+  if (o.variant == ScreeningVariant::Nearest) {
+    for (int m : s.nearestCluster(r.depths)) r.member[m] = 1;
   } else {
-    unsigned region = 0;
-    for (const auto& box : boxes) {
-      const cv::Rect2f r = dilate(box.rect, opt_.box_dilation);
-      idx.clear();
-      for (size_t i = 0; i < n; ++i) {
-        if (inside(r, frame.keypoints[i].pt)) {
-          idx.push_back(static_cast<int>(i));
-          in_any[i] = 1;
-        }
-      }
-      if (opt_.mode == DynamicMode::Detect) {
-        for (int i : idx) drop[i] = 1;
-      } else {
-        screenRegion(idx, region, opt_.dilation_depth_only ? &box.rect : nullptr, &r);
-      }
-      ++region;
+    // Region k reseeds the RNG with seed + 7919 k: regions are independent of each other and
+    // of previous frames.
+    ConsensusResult c = s.depthRansac(r.depths, o.seed + 7919u * r.index);
+    iterations = c.iterations;
+    for (int m : c.members) r.member[m] = 1;
+  }
+  if (o.variant != ScreeningVariant::Paper) s.grow(r.pts, r.depths, r.member);
+  return iterations;
+}
+
+// The flat-box rule on the person's set of a box region.
+bool isFlatBox(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+               const detection::Boxes& boxes) {
+  std::vector<int> cluster;
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) cluster.push_back(r.with_depth[m]);
+  FlatBoxOptions fo;
+  fo.ring = o.flat_box_ring;
+  fo.tolerance = o.flat_box_tolerance;
+  fo.fraction = o.flat_box_fraction;
+  fo.seed = o.seed + 7919u * r.index;
+  std::vector<cv::Rect2f> others;
+  for (size_t k = 0; k < boxes.size(); ++k)
+    if (k != r.index) others.push_back(dilate(boxes[k].rect, o.box_dilation));
+  return testFlatBox(frame, *r.box, cluster, fo, others).flat;
+}
+
+// Whether a depth pixel within [lo, hi] lies in the keypoint's window (radius times its scale).
+bool personDepthNear(const cv::Mat& depth_m, const cv::KeyPoint& kp, double radius_px, float lo,
+                     float hi) {
+  const int r = std::max(1, static_cast<int>(std::lround(radius_px * kp.size / 31.f)));
+  const cv::Rect img(0, 0, depth_m.cols, depth_m.rows);
+  const cv::Rect win = cv::Rect(static_cast<int>(std::lround(kp.pt.x)) - r,
+                                static_cast<int>(std::lround(kp.pt.y)) - r, 2 * r + 1,
+                                2 * r + 1) & img;
+  for (int v = win.y; v < win.br().y; ++v) {
+    const float* row = depth_m.ptr<float>(v);
+    for (int u = win.x; u < win.br().x; ++u)
+      if (row[u] >= lo && row[u] <= hi) return true;
+  }
+  return false;
+}
+
+// Silhouette rule: keypoints of the box left static whose depth is missing or outside the
+// person's range [lo, hi] (+- grow_depth_m), with a person-depth pixel within the radius.
+// Returns how many it dropped.
+int markSilhouette(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+                   const cv::Mat& depth_m, std::vector<uint8_t>& drop) {
+  float lo = std::numeric_limits<float>::max(), hi = 0.f;
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) lo = std::min(lo, r.depths[m]), hi = std::max(hi, r.depths[m]);
+  if (hi <= 0.f) return 0;
+  lo -= static_cast<float>(o.grow_depth_m);
+  hi += static_cast<float>(o.grow_depth_m);
+  int dropped = 0;
+  for (int i : r.idx) {
+    if (drop[i] || !inside(*r.box, frame.keypoints[i].pt)) continue;
+    const float d = frame.depth[i];
+    if (d >= lo && d <= hi) continue;  // at the person's depth: Algorithm 1's call stands
+    if (personDepthNear(depth_m, frame.keypoints[i], o.silhouette_radius_px, lo, hi)) {
+      drop[i] = 1;
+      ++dropped;
     }
   }
+  return dropped;
+}
 
-  for (size_t i = 0; i < n; ++i) {
+// NearDynamic: whether a person keypoint with depth lies within no_depth_radius_px of p.
+bool memberNear(const ScreeningOptions& o, const Region& r, const cv::Point2f& p) {
+  const float nd2 = static_cast<float>(o.no_depth_radius_px * o.no_depth_radius_px);
+  for (size_t m = 0; m < r.pts.size(); ++m) {
+    if (!r.member[m]) continue;
+    const float dx = r.pts[m].x - p.x, dy = r.pts[m].y - p.y;
+    if (dx * dx + dy * dy < nd2) return true;
+  }
+  return false;
+}
+
+// Nearest: the label of the closest keypoint with depth within grow_radius_px (0 if none).
+uint8_t nearestLabel(const ScreeningOptions& o, const Region& r, const cv::Point2f& p) {
+  float best = static_cast<float>(o.grow_radius_px * o.grow_radius_px);
+  uint8_t label = 0;
+  for (size_t m = 0; m < r.pts.size(); ++m) {
+    const float dx = r.pts[m].x - p.x, dy = r.pts[m].y - p.y, d2 = dx * dx + dy * dy;
+    if (d2 < best) {
+      best = d2;
+      label = r.member[m];
+    }
+  }
+  return label;
+}
+
+// The no-depth rule over the region's keypoints without depth.
+void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+                 std::vector<uint8_t>& drop) {
+  using Rule = ScreeningOptions::NoDepthRule;
+  if (o.no_depth == Rule::Static) return;
+  for (int i : r.idx) {
+    if (frame.depth[i] > 0) continue;
+    const cv::Point2f p = frame.keypoints[i].pt;
+    if (r.core && !inside(*r.core, p)) continue;  // dilation ring: depth only
+    bool dynamic = true;  // Rule::Dynamic
+    if (o.no_depth == Rule::NearDynamic) dynamic = memberNear(o, r, p);
+    if (o.no_depth == Rule::Nearest) dynamic = nearestLabel(o, r, p) != 0;
+    if (dynamic) drop[i] = 1;
+  }
+}
+
+// Screens one region: its person set is dropped, then the silhouette and no-depth rules, unless
+// the flat-box rule leaves the box alone.
+void screenRegion(const Screener& s, const features::FeatureFrame& frame, Region& r,
+                  const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                  std::vector<uint8_t>& drop, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  st.iterations += findPerson(s, frame, r);
+  if (r.box && o.reject_flat_boxes && isFlatBox(o, frame, r, boxes)) {
+    ++st.flat_boxes;
+    return;  // a picture or static surface: nothing in this box is dropped
+  }
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) drop[r.with_depth[m]] = 1;
+  if (r.box && !silhouette_depth.empty())
+    st.silhouette += markSilhouette(o, frame, r, silhouette_depth, drop);
+  markNoDepth(o, frame, r, drop);
+}
+
+// Box modes: the keypoints of each dilated box (in_any) are dropped (detect) or screened.
+void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
+                 const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                 std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  Region r;
+  r.idx.reserve(frame.keypoints.size());
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    const cv::Rect2f dilated = dilate(boxes[b].rect, o.box_dilation);
+    r.index = static_cast<unsigned>(b);
+    r.box = &dilated;
+    r.core = o.dilation_depth_only ? &boxes[b].rect : nullptr;
+    r.idx.clear();
+    for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+      if (inside(dilated, frame.keypoints[i].pt)) {
+        r.idx.push_back(static_cast<int>(i));
+        in_any[i] = 1;
+      }
+    }
+    if (o.mode == DynamicMode::Detect) {
+      for (int i : r.idx) drop[i] = 1;
+    } else {
+      screenRegion(s, frame, r, boxes, silhouette_depth, drop, st);
+    }
+  }
+}
+
+// Writes the drops of the keypoints in a region into frame.dynamic and counts them.
+void applyDrops(const std::vector<uint8_t>& in_any, const std::vector<uint8_t>& drop,
+                features::FeatureFrame& frame, ScreeningStats& st) {
+  for (size_t i = 0; i < in_any.size(); ++i) {
     if (!in_any[i]) continue;
     ++st.in_boxes;
     if (drop[i]) {
@@ -403,6 +445,31 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
     } else {
       ++st.kept;
     }
+  }
+}
+
+}  // namespace
+
+ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                                const cv::Mat& depth_m) const {
+  Stopwatch sw;
+  ScreeningStats st;
+  const size_t n = frame.keypoints.size();
+  if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
+  checkDepths(opt_, frame);
+  if (opt_.mode != DynamicMode::Off) {
+    const cv::Mat silhouette_depth = silhouetteDepth(opt_, frame, depth_m);
+    std::vector<uint8_t> in_any(n, 0), drop(n, 0);
+    if (opt_.mode == DynamicMode::Geometry) {
+      // The whole image is one region.
+      Region r;
+      for (size_t i = 0; i < n; ++i) r.idx.push_back(static_cast<int>(i));
+      std::fill(in_any.begin(), in_any.end(), 1);
+      screenRegion(*this, frame, r, boxes, silhouette_depth, drop, st);
+    } else {
+      screenBoxes(*this, frame, boxes, silhouette_depth, in_any, drop, st);
+    }
+    applyDrops(in_any, drop, frame, st);
   }
   st.ms = sw.ms();
   return st;
