@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/detection/decode.h"
 #include "yolo_slam/detection/model_files.h"
@@ -27,6 +28,36 @@ std::vector<std::string> defaultExtraModelPaths() {
   return {joinPath(sharedDir(), "models/yolo-fastest-1.1-body")};
 }
 
+namespace {
+
+const OptionTable<DetectorOptions>& detectorFields() {
+  using O = DetectorOptions;
+  static const OptionTable<O> table = {
+      {"Detector.inputWidth", &O::input_width, Range::atLeast(0)},
+      {"Detector.inputHeight", &O::input_height, Range::atLeast(0)},
+      {"Detector.letterbox", &O::letterbox},
+      {"Detector.confThreshold", &O::conf_threshold, Range::open(0, 1)},
+      {"Detector.nmsThreshold", &O::nms_threshold, Range::openClosed(0, 1)},
+      {"Detector.threads", &O::threads, Range::atLeast(1)},
+  };
+  return table;
+}
+
+// Rules across fields and on the class list, which the table cannot state.
+void checkInputAndClasses(const DetectorOptions& o, const std::string& where) {
+  for (const auto& [key, v] : {std::make_pair("Detector.inputWidth", o.input_width),
+                               std::make_pair("Detector.inputHeight", o.input_height)})
+    if (v % 32) rejectOption(where, key, "a multiple of 32", std::to_string(v));
+  if ((o.input_width == 0) != (o.input_height == 0))
+    rejectOption(where, "Detector.inputHeight",
+                 "0 exactly when Detector.inputWidth is 0 (native size)",
+                 std::to_string(o.input_height));
+  if (o.dynamic_classes.empty())
+    rejectOption(where, "Detector.dynamicClasses", "a list of at least one class name", "[]");
+}
+
+}  // namespace
+
 DetectorOptions DetectorOptions::load(const Config& cfg) {
   DetectorOptions o;
   // Empty keeps the default (YOLO_SLAM_MODEL or the shared model); a relative path is taken
@@ -38,26 +69,15 @@ DetectorOptions DetectorOptions::load(const Config& cfg) {
     for (const auto& m : cfg.getStringList("Detector.extraModels", {}))
       if (!m.empty()) o.extra_models.push_back(m.front() == '/' ? m : joinPath(packageDir(), m));
   }
-  o.input_width = cfg.getInt("Detector.inputWidth", o.input_width);
-  o.input_height = cfg.getInt("Detector.inputHeight", o.input_height);
-  o.letterbox = cfg.getBool("Detector.letterbox", o.letterbox);
-  o.conf_threshold = float(cfg.getDouble("Detector.confThreshold", o.conf_threshold));
-  o.nms_threshold = float(cfg.getDouble("Detector.nmsThreshold", o.nms_threshold));
-  o.threads = cfg.getInt("Detector.threads", o.threads);
+  readOptions(cfg, o, detectorFields());
   o.dynamic_classes = cfg.getStringList("Detector.dynamicClasses", o.dynamic_classes);
-  const std::string where = cfg.path().empty() ? std::string("settings") : cfg.path();
-  auto bad = [&](const std::string& key, const std::string& why) {
-    throw Error(where + ": key '" + key + "' " + why);
-  };
-  if (o.input_width < 0 || o.input_height < 0 || (o.input_width == 0) != (o.input_height == 0))
-    bad("Detector.inputWidth/inputHeight", "must both be 0 (native size) or both positive");
-  if (o.input_width % 32 || o.input_height % 32)
-    bad("Detector.inputWidth/inputHeight", "must be multiples of 32 (the largest YOLO stride)");
-  if (!(o.conf_threshold > 0 && o.conf_threshold < 1)) bad("Detector.confThreshold", "must be in (0,1)");
-  if (!(o.nms_threshold > 0 && o.nms_threshold <= 1)) bad("Detector.nmsThreshold", "must be in (0,1]");
-  if (o.threads < 1) bad("Detector.threads", "must be at least 1");
-  if (o.dynamic_classes.empty()) bad("Detector.dynamicClasses", "must list at least one class name");
+  checkInputAndClasses(o, configName(cfg));
   return o;
+}
+
+void DetectorOptions::validate(const std::string& where) const {
+  checkOptions(*this, where, detectorFields());
+  checkInputAndClasses(*this, where);
 }
 
 Detector::~Detector() = default;
@@ -166,7 +186,7 @@ struct YoloDetector::Impl {
 YoloDetector::YoloDetector(const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.opt = options;
-  if (m.opt.threads < 1) throw Error("Detector.threads must be at least 1");
+  m.opt.validate();
   m.files = resolveModel(options.model);
   m.names = readClassNames(m.files.names);
   m.keep.assign(m.names.size(), false);

@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -19,28 +20,39 @@ namespace features {
 // Options
 // ------------------------------------------------------------------------------------------
 
-void OrbOptions::validate(const std::string& where) const {
-  auto bad = [&](const char* key, const std::string& why) {
-    throw Error(where + ": key '" + key + "' " + why);
+namespace {
+
+const OptionTable<OrbOptions>& orbFields() {
+  using O = OrbOptions;
+  static const OptionTable<O> table = {
+      {"ORBextractor.nFeatures", &O::n_features, Range::atLeast(1)},
+      {"ORBextractor.scaleFactor", &O::scale_factor, Range::openClosed(1, 4)},
+      {"ORBextractor.nLevels", &O::n_levels, Range::closed(1, 32)},
+      {"ORBextractor.iniThFAST", &O::ini_th_fast, Range::closed(1, 254)},
+      {"ORBextractor.minThFAST", &O::min_th_fast, Range::closed(1, 254)},
   };
-  if (n_features <= 0) bad("ORBextractor.nFeatures", "must be a positive integer (default 1000)");
-  if (!(scale_factor > 1.0) || !std::isfinite(scale_factor) || scale_factor > 4.0)
-    bad("ORBextractor.scaleFactor", "must be in (1, 4] (default 1.2)");
-  if (n_levels < 1 || n_levels > 32) bad("ORBextractor.nLevels", "must be in [1, 32] (default 8)");
-  if (ini_th_fast < 1 || ini_th_fast > 254)
-    bad("ORBextractor.iniThFAST", "must be in [1, 254] (default 20)");
-  if (min_th_fast < 1 || min_th_fast > ini_th_fast)
-    bad("ORBextractor.minThFAST", "must be in [1, iniThFAST] (default 7)");
+  return table;
+}
+
+// The fallback threshold is the lower one.
+void checkThresholds(const OrbOptions& o, const std::string& where) {
+  if (o.min_th_fast > o.ini_th_fast)
+    rejectOption(where, "ORBextractor.minThFAST",
+                 "in [1, iniThFAST = " + std::to_string(o.ini_th_fast) + "]",
+                 std::to_string(o.min_th_fast));
+}
+
+}  // namespace
+
+void OrbOptions::validate(const std::string& where) const {
+  checkOptions(*this, where, orbFields());
+  checkThresholds(*this, where);
 }
 
 OrbOptions OrbOptions::load(const Config& cfg) {
   OrbOptions o;
-  o.n_features = cfg.getInt("ORBextractor.nFeatures", o.n_features);
-  o.scale_factor = cfg.getDouble("ORBextractor.scaleFactor", o.scale_factor);
-  o.n_levels = cfg.getInt("ORBextractor.nLevels", o.n_levels);
-  o.ini_th_fast = cfg.getInt("ORBextractor.iniThFAST", o.ini_th_fast);
-  o.min_th_fast = cfg.getInt("ORBextractor.minThFAST", o.min_th_fast);
-  o.validate(cfg.path().empty() ? std::string("<config>") : cfg.path());
+  readOptions(cfg, o, orbFields());
+  checkThresholds(o, configName(cfg));
   return o;
 }
 

@@ -61,7 +61,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       std::string mode;
       if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
-      if (!use_boxes_) sopt.track_boxes = false;
+      if (!use_boxes_) sopt.tracker.enabled = false;
       front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
       const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
       async_boxes_ = use_boxes_ && aopt.enabled;

@@ -1,6 +1,6 @@
 #include "yolo_slam/screening/box_tracker.h"
 
-#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/features/match_near.h"
 #include "yolo_slam/screening/screener.h"
 
@@ -17,30 +17,34 @@ double iou(const cv::Rect2f& a, const cv::Rect2f& b) {
   return uni > 0 ? inter / uni : 0.0;
 }
 
-BoxTrackerOptions BoxTrackerOptions::from(const ScreeningOptions& s) {
+namespace {
+
+const OptionTable<BoxTrackerOptions>& trackerFields() {
+  using O = BoxTrackerOptions;
+  static const OptionTable<O> table = {
+      {"Screening.trackBoxes", &O::enabled},
+      {"Screening.trackMaxAge", &O::max_age, Range::atLeast(1)},
+      {"Screening.trackRadius", &O::radius_px, Range::positive()},
+      {"Screening.trackMaxHamming", &O::max_hamming, Range::closed(0, 256)},
+      {"Screening.trackMinMatches", &O::min_matches, Range::atLeast(1)},
+      {"Screening.trackMinScore", &O::min_score, Range::closed(0, 1)},
+  };
+  return table;
+}
+
+}  // namespace
+
+BoxTrackerOptions BoxTrackerOptions::load(const Config& cfg) {
   BoxTrackerOptions o;
-  o.max_age = s.track_max_age;
-  o.radius_px = s.track_radius_px;
-  o.max_hamming = s.track_max_hamming;
-  o.min_matches = s.track_min_matches;
-  o.min_score = s.track_min_score;
+  readOptions(cfg, o, trackerFields());
   return o;
 }
 
 void BoxTrackerOptions::validate(const std::string& where) const {
-  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
-  if (max_age < 1) bad("trackMaxAge must be >= 1 (frames), got " + std::to_string(max_age));
-  if (!(radius_px > 0) || !std::isfinite(radius_px))
-    bad("trackRadius must be > 0 (pixels), got " + std::to_string(radius_px));
-  if (max_hamming < 0 || max_hamming > 256)
-    bad("trackMaxHamming must be in [0, 256], got " + std::to_string(max_hamming));
-  if (min_matches < 1) bad("trackMinMatches must be >= 1, got " + std::to_string(min_matches));
-  if (!(min_score >= 0 && min_score <= 1))
-    bad("trackMinScore must be in [0, 1], got " + std::to_string(min_score));
-  if (!(iou_associate > 0 && iou_associate <= 1))
-    bad("IoU association threshold must be in (0, 1], got " + std::to_string(iou_associate));
-  if (!(covered_fraction > 0 && covered_fraction <= 1))
-    bad("covered fraction must be in (0, 1], got " + std::to_string(covered_fraction));
+  checkOptions(*this, where, trackerFields());
+  // Set in code only, no key.
+  checkOption(where, "BoxTrackerOptions::iou_associate", iou_associate, Range::fraction());
+  checkOption(where, "BoxTrackerOptions::covered_fraction", covered_fraction, Range::fraction());
 }
 
 BoxTracker::BoxTracker(const BoxTrackerOptions& options) : opt_(options) { opt_.validate(); }

@@ -6,17 +6,18 @@ namespace screening {
 Stages stagesFor(const ScreeningOptions& o) {
   Stages s;
   s.detection = o.mode == DynamicMode::Detect || o.mode == DynamicMode::DetectGeometry;
-  s.box_tracking = s.detection && o.track_boxes;
+  s.box_tracking = s.detection && o.tracker.enabled;
   const bool screens = o.mode != DynamicMode::Off;
-  s.label_propagation = screens && o.propagate_labels;
-  s.static_box_veto = screens && o.static_box_veto;
+  s.label_propagation = screens && o.temporal.propagate_labels;
+  s.static_box_veto = screens && o.temporal.static_box_veto;
   return s;
 }
 
 ScreeningPipeline::ScreeningPipeline(const ScreeningOptions& options) : screener_(options) {
   const Stages stages = stagesFor(options);
-  if (stages.box_tracking) box_tracker_ = std::make_unique<BoxTracker>(BoxTrackerOptions::from(options));
-  if (stages.temporal()) temporal_ = std::make_unique<TemporalScreening>(TemporalOptions::from(options));
+  if (stages.box_tracking) box_tracker_ = std::make_unique<BoxTracker>(options.tracker);
+  if (stages.temporal())
+    temporal_ = std::make_unique<TemporalScreening>(options.temporal, options.box_dilation);
 }
 
 PipelineResult ScreeningPipeline::process(features::FeatureFrame& frame,

@@ -1,10 +1,9 @@
 #include "yolo_slam/screening/screener.h"
-#include "yolo_slam/screening/box_tracker.h"
 #include "yolo_slam/screening/flat_box.h"
-#include "yolo_slam/screening/temporal.h"
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -14,143 +13,84 @@
 #include <cmath>
 #include <limits>
 #include <random>
-#include <sstream>
 
 namespace yolo_slam {
 namespace screening {
 
-DynamicMode parseDynamicMode(const std::string& s) {
-  if (s == "off") return DynamicMode::Off;
-  if (s == "detect") return DynamicMode::Detect;
-  if (s == "geometry") return DynamicMode::Geometry;
-  if (s == "detect+geometry") return DynamicMode::DetectGeometry;
-  throw Error("unknown dynamic mode '" + s +
-              "'; use one of off, detect, geometry, detect+geometry");
+namespace {
+
+const EnumNames<DynamicMode>& modeNames() {
+  using M = DynamicMode;
+  static const EnumNames<M> names = {{"off", M::Off}, {"detect", M::Detect},
+                                     {"geometry", M::Geometry}, {"detect+geometry", M::DetectGeometry}};
+  return names;
 }
 
-std::string toString(DynamicMode m) {
-  switch (m) {
-    case DynamicMode::Off: return "off";
-    case DynamicMode::Detect: return "detect";
-    case DynamicMode::Geometry: return "geometry";
-    case DynamicMode::DetectGeometry: return "detect+geometry";
-  }
-  return "?";
+const EnumNames<ScreeningVariant>& variantNames() {
+  using V = ScreeningVariant;
+  static const EnumNames<V> names = {{"paper", V::Paper}, {"grow", V::Grow}, {"nearest", V::Nearest}};
+  return names;
 }
+
+const EnumNames<ScreeningOptions::NoDepthRule>& noDepthNames() {
+  using R = ScreeningOptions::NoDepthRule;
+  static const EnumNames<R> names = {{"dynamic", R::Dynamic}, {"static", R::Static},
+                                     {"nearest", R::Nearest}, {"near-dynamic", R::NearDynamic}};
+  return names;
+}
+
+const OptionTable<ScreeningOptions>& screeningFields() {
+  using O = ScreeningOptions;
+  static const OptionTable<O> table = {
+      {"Screening.varianceThreshold", &O::variance_threshold_m2, Range::positive()},
+      {"Screening.probability", &O::probability, Range::open(0, 1)},
+      {"Screening.maxIterations", &O::max_iterations, Range::atLeast(1)},
+      {"Screening.seed", &O::seed, Range::atLeast(0)},
+      {"Screening.boxDilation", &O::box_dilation, Range::closed(0, 1)},
+      {"Screening.growRadius", &O::grow_radius_px, Range::positive()},
+      {"Screening.growDepth", &O::grow_depth_m, Range::positive()},
+      {"Screening.clusterMinFraction", &O::cluster_min_fraction, Range::fraction()},
+      {"Screening.noDepthRadius", &O::no_depth_radius_px, Range::positive()},
+      {"Screening.silhouetteRadius", &O::silhouette_radius_px, Range::atLeast(0)},
+      {"Screening.dilationDepthOnly", &O::dilation_depth_only},
+      {"Screening.rejectFlatBoxes", &O::reject_flat_boxes},
+      {"Screening.flatBoxFraction", &O::flat_box_fraction, Range::fraction()},
+      {"Screening.flatBoxTolerance", &O::flat_box_tolerance, Range::positive()},
+      {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
+  };
+  return table;
+}
+
+}  // namespace
+
+DynamicMode parseDynamicMode(const std::string& s) {
+  if (const DynamicMode* m = findEnum(modeNames(), s)) return *m;
+  throw Error("unknown dynamic mode '" + s + "'; use one of " + listNames(modeNames()));
+}
+
+std::string toString(DynamicMode m) { return nameOf(modeNames(), m); }
 
 ScreeningVariant parseScreeningVariant(const std::string& s) {
-  if (s == "paper") return ScreeningVariant::Paper;
-  if (s == "grow") return ScreeningVariant::Grow;
-  if (s == "nearest") return ScreeningVariant::Nearest;
-  throw Error("unknown screening variant '" + s + "'; use paper, grow or nearest");
+  if (const ScreeningVariant* v = findEnum(variantNames(), s)) return *v;
+  throw Error("unknown screening variant '" + s + "'; use one of " + listNames(variantNames()));
 }
 
-std::string toString(ScreeningVariant v) {
-  switch (v) {
-    case ScreeningVariant::Paper: return "paper";
-    case ScreeningVariant::Grow: return "grow";
-    case ScreeningVariant::Nearest: return "nearest";
-  }
-  return "?";
-}
+std::string toString(ScreeningVariant v) { return nameOf(variantNames(), v); }
 
 void ScreeningOptions::validate(const std::string& where) const {
-  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
-  if (!(variance_threshold_m2 > 0) || !std::isfinite(variance_threshold_m2))
-    bad("variance threshold must be > 0 (m^2), got " + std::to_string(variance_threshold_m2));
-  if (!(probability > 0 && probability < 1))
-    bad("probability must be in (0, 1), got " + std::to_string(probability));
-  if (max_iterations < 1) bad("maxIterations must be >= 1, got " + std::to_string(max_iterations));
-  if (!(box_dilation >= 0 && box_dilation <= 1))
-    bad("boxDilation must be in [0, 1], got " + std::to_string(box_dilation));
-  if (!(grow_radius_px > 0) || !std::isfinite(grow_radius_px))
-    bad("growRadius must be > 0 (pixels), got " + std::to_string(grow_radius_px));
-  if (!(grow_depth_m > 0) || !std::isfinite(grow_depth_m))
-    bad("growDepth must be > 0 (metres), got " + std::to_string(grow_depth_m));
-  if (!(cluster_min_fraction > 0 && cluster_min_fraction <= 1))
-    bad("clusterMinFraction must be in (0, 1], got " + std::to_string(cluster_min_fraction));
-  if (!(no_depth_radius_px > 0) || !std::isfinite(no_depth_radius_px))
-    bad("noDepthRadius must be > 0 (pixels), got " + std::to_string(no_depth_radius_px));
-  if (!(silhouette_radius_px >= 0) || !std::isfinite(silhouette_radius_px))
-    bad("silhouetteRadius must be >= 0 (pixels; 0 = off), got " + std::to_string(silhouette_radius_px));
-  if (!(flat_box_fraction > 0 && flat_box_fraction <= 1))
-    bad("flatBoxFraction must be in (0, 1], got " + std::to_string(flat_box_fraction));
-  if (!(flat_box_tolerance > 0) || !std::isfinite(flat_box_tolerance))
-    bad("flatBoxTolerance must be > 0 (1/m, inverse depth), got " + std::to_string(flat_box_tolerance));
-  if (!(flat_box_ring > 0 && flat_box_ring <= 2))
-    bad("flatBoxRing must be in (0, 2] (fraction of the box size), got " + std::to_string(flat_box_ring));
-  // The tracker's and the temporal evidence's own checks, with the same key names.
-  BoxTrackerOptions::from(*this).validate(where);
-  TemporalOptions::from(*this).validate(where);
+  checkOptions(*this, where, screeningFields());
+  tracker.validate(where);
+  temporal.validate(where);
 }
 
 ScreeningOptions ScreeningOptions::load(const Config& cfg) {
   ScreeningOptions o;
-  const std::string file = cfg.path().empty() ? std::string("<config>") : cfg.path();
-  auto rethrow = [&](const std::string& key, const Error& e) {
-    throw Error(file + ": key '" + key + "': " + e.what());
-  };
-  try {
-    o.mode = parseDynamicMode(cfg.getString("Screening.mode", toString(o.mode)));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind(file, 0) == 0) throw;
-    rethrow("Screening.mode", e);
-  }
-  try {
-    o.variant = parseScreeningVariant(cfg.getString("Screening.variant", toString(o.variant)));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind(file, 0) == 0) throw;
-    rethrow("Screening.variant", e);
-  }
-  o.variance_threshold_m2 = cfg.getDouble("Screening.varianceThreshold", o.variance_threshold_m2);
-  o.probability = cfg.getDouble("Screening.probability", o.probability);
-  o.max_iterations = cfg.getInt("Screening.maxIterations", o.max_iterations);
-  int seed = cfg.getInt("Screening.seed", static_cast<int>(o.seed));
-  if (seed < 0) throw Error(file + ": key 'Screening.seed' must be >= 0, got " + std::to_string(seed));
-  o.seed = static_cast<unsigned>(seed);
-  static const char* const kNoDepthNames[] = {"dynamic", "static", "nearest", "near-dynamic"};
-  std::string nd = cfg.getString("Screening.noDepth", kNoDepthNames[static_cast<int>(o.no_depth)]);
-  if (nd == "dynamic") {
-    o.no_depth = NoDepthRule::Dynamic;
-  } else if (nd == "static") {
-    o.no_depth = NoDepthRule::Static;
-  } else if (nd == "nearest") {
-    o.no_depth = NoDepthRule::Nearest;
-  } else if (nd == "near-dynamic") {
-    o.no_depth = NoDepthRule::NearDynamic;
-  } else {
-    throw Error(file + ": key 'Screening.noDepth' must be dynamic, static, nearest or near-dynamic, got '" + nd + "'");
-  }
-  o.box_dilation = cfg.getDouble("Screening.boxDilation", o.box_dilation);
-  o.grow_radius_px = cfg.getDouble("Screening.growRadius", o.grow_radius_px);
-  o.grow_depth_m = cfg.getDouble("Screening.growDepth", o.grow_depth_m);
-  o.cluster_min_fraction = cfg.getDouble("Screening.clusterMinFraction", o.cluster_min_fraction);
-  o.no_depth_radius_px = cfg.getDouble("Screening.noDepthRadius", o.no_depth_radius_px);
-  o.silhouette_radius_px = cfg.getDouble("Screening.silhouetteRadius", o.silhouette_radius_px);
-  o.dilation_depth_only = cfg.getBool("Screening.dilationDepthOnly", o.dilation_depth_only);
-  o.reject_flat_boxes = cfg.getBool("Screening.rejectFlatBoxes", o.reject_flat_boxes);
-  o.flat_box_fraction = cfg.getDouble("Screening.flatBoxFraction", o.flat_box_fraction);
-  o.flat_box_tolerance = cfg.getDouble("Screening.flatBoxTolerance", o.flat_box_tolerance);
-  o.flat_box_ring = cfg.getDouble("Screening.flatBoxRing", o.flat_box_ring);
-  o.track_boxes = cfg.getBool("Screening.trackBoxes", o.track_boxes);
-  o.track_max_age = cfg.getInt("Screening.trackMaxAge", o.track_max_age);
-  o.track_radius_px = cfg.getDouble("Screening.trackRadius", o.track_radius_px);
-  o.track_max_hamming = cfg.getInt("Screening.trackMaxHamming", o.track_max_hamming);
-  o.track_min_matches = cfg.getInt("Screening.trackMinMatches", o.track_min_matches);
-  o.track_min_score = cfg.getDouble("Screening.trackMinScore", o.track_min_score);
-  o.propagate_labels = cfg.getBool("Screening.propagateLabels", o.propagate_labels);
-  o.propagate_max_age = cfg.getInt("Screening.propagateMaxAge", o.propagate_max_age);
-  o.static_box_veto = cfg.getBool("Screening.staticBoxVeto", o.static_box_veto);
-  o.static_box_fraction = cfg.getDouble("Screening.staticBoxFraction", o.static_box_fraction);
-  o.static_box_min_points = cfg.getInt("Screening.staticBoxMinPoints", o.static_box_min_points);
-  o.static_box_max_score = cfg.getDouble("Screening.staticBoxMaxScore", o.static_box_max_score);
-  o.temporal_radius_px = cfg.getDouble("Screening.temporalRadius", o.temporal_radius_px);
-  o.temporal_max_hamming = cfg.getInt("Screening.temporalMaxHamming", o.temporal_max_hamming);
-  o.temporal_max_depth_change_m =
-      cfg.getDouble("Screening.temporalMaxDepthChange", o.temporal_max_depth_change_m);
-  o.temporal_static_tolerance_px =
-      cfg.getDouble("Screening.temporalStaticTolerance", o.temporal_static_tolerance_px);
-  o.validate(file + ": Screening.*");
+  o.mode = readEnum(cfg, "Screening.mode", o.mode, modeNames());
+  o.variant = readEnum(cfg, "Screening.variant", o.variant, variantNames());
+  o.no_depth = readEnum(cfg, "Screening.noDepth", o.no_depth, noDepthNames());
+  readOptions(cfg, o, screeningFields());
+  o.tracker = BoxTrackerOptions::load(cfg);
+  o.temporal = TemporalOptions::load(cfg);
   return o;
 }
 
@@ -283,178 +223,220 @@ bool inside(const cv::Rect2f& r, const cv::Point2f& p) {
   return p.x >= r.x && p.y >= r.y && p.x < r.x + r.width && p.y < r.y + r.height;
 }
 
-ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
-                                const cv::Mat& depth_m) const {
-  Stopwatch sw;
-  ScreeningStats st;
+namespace {
+
+// One RANSAC region of screen(): a dilated box, or the whole image in geometry mode. The
+// buffers are reused from region to region.
+struct Region {
+  unsigned index = 0;                // the box's index (0 in geometry mode); seeds the RNG
+  const cv::Rect2f* box = nullptr;   // the dilated box; null in geometry mode
+  const cv::Rect2f* core = nullptr;  // the detected box when dilation_depth_only, else null
+  std::vector<int> idx;              // every keypoint of the region
+  // Of those, the keypoints with depth, their depths and positions, and which of them are
+  // the person (set by findPerson).
+  std::vector<int> with_depth;
+  std::vector<float> depths;
+  std::vector<cv::Point2f> pts;
+  std::vector<uint8_t> member;
+};
+
+// The depth image for the silhouette rule, empty when the rule is off; throws unless it is
+// CV_32FC1 of the frame's size.
+cv::Mat silhouetteDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
+                        const cv::Mat& depth_m) {
+  if (o.silhouette_radius_px <= 0 || depth_m.empty()) return cv::Mat();
+  if (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height)
+    throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of "
+                "the frame's size (" + std::to_string(frame.width) + "x" +
+                std::to_string(frame.height) + ")");
+  return depth_m;
+}
+
+// The modes with geometry need a depth per keypoint.
+void checkDepths(const ScreeningOptions& o, const features::FeatureFrame& frame) {
   const size_t n = frame.keypoints.size();
-  if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
-  if (frame.depth.size() != n && opt_.mode != DynamicMode::Off && opt_.mode != DynamicMode::Detect) {
+  if (frame.depth.size() != n && o.mode != DynamicMode::Off && o.mode != DynamicMode::Detect) {
     throw Error("screening: frame has " + std::to_string(n) + " keypoints but " +
                 std::to_string(frame.depth.size()) + " depths; build it with buildFeatureFrame");
   }
-  if (opt_.mode == DynamicMode::Off) {
-    st.ms = sw.ms();
-    return st;
+}
+
+// Algorithm 1 (or the nearest cluster), then the grow step, over the region's keypoints with
+// depth. Returns the RANSAC iterations.
+int findPerson(const Screener& s, const features::FeatureFrame& frame, Region& r) {
+  const ScreeningOptions& o = s.options();
+  r.depths.clear();
+  r.with_depth.clear();
+  r.pts.clear();
+  for (int i : r.idx) {
+    if (frame.depth[i] > 0) {
+      r.depths.push_back(frame.depth[i]);
+      r.with_depth.push_back(i);
+      r.pts.push_back(frame.keypoints[i].pt);
+    }
   }
-
-  std::vector<uint8_t> in_any(n, 0), drop(n, 0);
-  std::vector<int> members;
-  std::vector<float> depths;
-  members.reserve(n);
-  depths.reserve(n);
-
-  // Silhouette rule: keypoints of the region left static whose depth is missing or outside the
-  // person's range [lo, hi] (+- grow_depth_m), with a depth pixel inside it within the radius.
-  const bool silhouette = opt_.silhouette_radius_px > 0 && !depth_m.empty();
-  if (silhouette && (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height))
-    throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of the "
-                "frame's size (" + std::to_string(frame.width) + "x" + std::to_string(frame.height) + ")");
-  auto markSilhouette = [&](const std::vector<int>& idx, const std::vector<float>& dep,
-                            const std::vector<uint8_t>& mem, const cv::Rect2f& box) {
-    float lo = std::numeric_limits<float>::max(), hi = 0.f;
-    for (size_t m = 0; m < mem.size(); ++m)
-      if (mem[m]) lo = std::min(lo, dep[m]), hi = std::max(hi, dep[m]);
-    if (hi <= 0.f) return;
-    lo -= static_cast<float>(opt_.grow_depth_m);
-    hi += static_cast<float>(opt_.grow_depth_m);
-    const cv::Rect img(0, 0, depth_m.cols, depth_m.rows);
-    for (int i : idx) {
-      if (drop[i] || !inside(box, frame.keypoints[i].pt)) continue;
-      const float d = frame.depth[i];
-      if (d >= lo && d <= hi) continue;  // at the person's depth: Algorithm 1's call stands
-      const cv::KeyPoint& kp = frame.keypoints[i];
-      const int r = std::max(1, static_cast<int>(std::lround(opt_.silhouette_radius_px * kp.size / 31.f)));
-      const cv::Rect win = cv::Rect(static_cast<int>(std::lround(kp.pt.x)) - r,
-                                    static_cast<int>(std::lround(kp.pt.y)) - r, 2 * r + 1, 2 * r + 1) & img;
-      bool near_person = false;
-      for (int v = win.y; v < win.br().y && !near_person; ++v) {
-        const float* row = depth_m.ptr<float>(v);
-        for (int u = win.x; u < win.br().x; ++u)
-          if (row[u] >= lo && row[u] <= hi) {
-            near_person = true;
-            break;
-          }
-      }
-      if (near_person) {
-        drop[i] = 1;
-        ++st.silhouette;
-      }
-    }
-  };
-
-  // One RANSAC region: keypoints `idx`. Region r reseeds the RNG with seed + 7919 r so regions
-  // are independent of each other and of previous frames.
-  std::vector<cv::Point2f> pts;
-  std::vector<uint8_t> member;
-  // core: the detected (undilated) box when dilation_depth_only, else null. region_box: the
-  // (dilated) box of a detection for the flat-box rule, null in geometry mode.
-  auto screenRegion = [&](const std::vector<int>& idx, unsigned region, const cv::Rect2f* core,
-                          const cv::Rect2f* region_box) {
-    depths.clear();
-    members.clear();
-    pts.clear();
-    for (int i : idx) {
-      if (frame.depth[i] > 0) {
-        depths.push_back(frame.depth[i]);
-        members.push_back(i);
-        pts.push_back(frame.keypoints[i].pt);
-      }
-    }
-    member.assign(depths.size(), 0);
-    if (opt_.variant == ScreeningVariant::Nearest) {
-      for (int m : nearestCluster(depths)) member[m] = 1;
-    } else {
-      ConsensusResult r = depthRansac(depths, opt_.seed + 7919u * region);
-      st.iterations += r.iterations;
-      for (int m : r.members) member[m] = 1;
-    }
-    if (opt_.variant != ScreeningVariant::Paper) grow(pts, depths, member);
-    if (region_box && opt_.reject_flat_boxes) {
-      std::vector<int> cluster;
-      for (size_t m = 0; m < member.size(); ++m)
-        if (member[m]) cluster.push_back(members[m]);
-      FlatBoxOptions fo;
-      fo.ring = opt_.flat_box_ring;
-      fo.tolerance = opt_.flat_box_tolerance;
-      fo.fraction = opt_.flat_box_fraction;
-      fo.seed = opt_.seed + 7919u * region;
-      std::vector<cv::Rect2f> others;  // region is the box's index in box mode
-      for (size_t k = 0; k < boxes.size(); ++k)
-        if (k != region) others.push_back(dilate(boxes[k].rect, opt_.box_dilation));
-      if (testFlatBox(frame, *region_box, cluster, fo, others).flat) {
-        ++st.flat_boxes;
-        return;  // a picture or static surface: nothing in this box is dropped
-      }
-    }
-    for (size_t m = 0; m < member.size(); ++m)
-      if (member[m]) drop[members[m]] = 1;
-    if (region_box && silhouette) markSilhouette(idx, depths, member, *region_box);
-    if (opt_.no_depth == ScreeningOptions::NoDepthRule::Static) return;
-    const float r2 = static_cast<float>(opt_.grow_radius_px * opt_.grow_radius_px);
-    const float nd2 = static_cast<float>(opt_.no_depth_radius_px * opt_.no_depth_radius_px);
-    for (int i : idx) {
-      if (frame.depth[i] > 0) continue;
-      if (core && !inside(*core, frame.keypoints[i].pt)) continue;  // dilation ring: depth only
-      if (opt_.no_depth == ScreeningOptions::NoDepthRule::Dynamic) {
-        drop[i] = 1;
-        continue;
-      }
-      if (opt_.no_depth == ScreeningOptions::NoDepthRule::NearDynamic) {
-        const cv::Point2f p = frame.keypoints[i].pt;
-        for (size_t m = 0; m < pts.size(); ++m) {
-          if (!member[m]) continue;
-          const float dx = pts[m].x - p.x, dy = pts[m].y - p.y;
-          if (dx * dx + dy * dy < nd2) {
-            drop[i] = 1;
-            break;
-          }
-        }
-        continue;
-      }
-      // Nearest: copy the label of the closest keypoint with depth within the radius.
-      const cv::Point2f p = frame.keypoints[i].pt;
-      float best = r2;
-      int label = 0;
-      for (size_t m = 0; m < pts.size(); ++m) {
-        const float dx = pts[m].x - p.x, dy = pts[m].y - p.y, d2 = dx * dx + dy * dy;
-        if (d2 < best) {
-          best = d2;
-          label = member[m];
-        }
-      }
-      if (label) drop[i] = 1;
-    }
-  };
-
-  std::vector<int> idx;
-  idx.reserve(n);
-  if (opt_.mode == DynamicMode::Geometry) {
-    // The whole image is one box.
-    for (size_t i = 0; i < n; ++i) idx.push_back(static_cast<int>(i));
-    std::fill(in_any.begin(), in_any.end(), 1);
-    screenRegion(idx, 0, nullptr, nullptr);
+  r.member.assign(r.depths.size(), 0);
+  int iterations = 0;
+  if (o.variant == ScreeningVariant::Nearest) {
+    for (int m : s.nearestCluster(r.depths)) r.member[m] = 1;
   } else {
-    unsigned region = 0;
-    for (const auto& box : boxes) {
-      const cv::Rect2f r = dilate(box.rect, opt_.box_dilation);
-      idx.clear();
-      for (size_t i = 0; i < n; ++i) {
-        if (inside(r, frame.keypoints[i].pt)) {
-          idx.push_back(static_cast<int>(i));
-          in_any[i] = 1;
-        }
-      }
-      if (opt_.mode == DynamicMode::Detect) {
-        for (int i : idx) drop[i] = 1;
-      } else {
-        screenRegion(idx, region, opt_.dilation_depth_only ? &box.rect : nullptr, &r);
-      }
-      ++region;
+    // Region k reseeds the RNG with seed + 7919 k: regions are independent of each other and
+    // of previous frames.
+    ConsensusResult c = s.depthRansac(r.depths, o.seed + 7919u * r.index);
+    iterations = c.iterations;
+    for (int m : c.members) r.member[m] = 1;
+  }
+  if (o.variant != ScreeningVariant::Paper) s.grow(r.pts, r.depths, r.member);
+  return iterations;
+}
+
+// The flat-box rule on the person's set of a box region.
+bool isFlatBox(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+               const detection::Boxes& boxes) {
+  std::vector<int> cluster;
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) cluster.push_back(r.with_depth[m]);
+  FlatBoxOptions fo;
+  fo.ring = o.flat_box_ring;
+  fo.tolerance = o.flat_box_tolerance;
+  fo.fraction = o.flat_box_fraction;
+  fo.seed = o.seed + 7919u * r.index;
+  std::vector<cv::Rect2f> others;
+  for (size_t k = 0; k < boxes.size(); ++k)
+    if (k != r.index) others.push_back(dilate(boxes[k].rect, o.box_dilation));
+  return testFlatBox(frame, *r.box, cluster, fo, others).flat;
+}
+
+// Whether a depth pixel within [lo, hi] lies in the keypoint's window (radius times its scale).
+bool personDepthNear(const cv::Mat& depth_m, const cv::KeyPoint& kp, double radius_px, float lo,
+                     float hi) {
+  const int r = std::max(1, static_cast<int>(std::lround(radius_px * kp.size / 31.f)));
+  const cv::Rect img(0, 0, depth_m.cols, depth_m.rows);
+  const cv::Rect win = cv::Rect(static_cast<int>(std::lround(kp.pt.x)) - r,
+                                static_cast<int>(std::lround(kp.pt.y)) - r, 2 * r + 1,
+                                2 * r + 1) & img;
+  for (int v = win.y; v < win.br().y; ++v) {
+    const float* row = depth_m.ptr<float>(v);
+    for (int u = win.x; u < win.br().x; ++u)
+      if (row[u] >= lo && row[u] <= hi) return true;
+  }
+  return false;
+}
+
+// Silhouette rule: keypoints of the box left static whose depth is missing or outside the
+// person's range [lo, hi] (+- grow_depth_m), with a person-depth pixel within the radius.
+// Returns how many it dropped.
+int markSilhouette(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+                   const cv::Mat& depth_m, std::vector<uint8_t>& drop) {
+  float lo = std::numeric_limits<float>::max(), hi = 0.f;
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) lo = std::min(lo, r.depths[m]), hi = std::max(hi, r.depths[m]);
+  if (hi <= 0.f) return 0;
+  lo -= static_cast<float>(o.grow_depth_m);
+  hi += static_cast<float>(o.grow_depth_m);
+  int dropped = 0;
+  for (int i : r.idx) {
+    if (drop[i] || !inside(*r.box, frame.keypoints[i].pt)) continue;
+    const float d = frame.depth[i];
+    if (d >= lo && d <= hi) continue;  // at the person's depth: Algorithm 1's call stands
+    if (personDepthNear(depth_m, frame.keypoints[i], o.silhouette_radius_px, lo, hi)) {
+      drop[i] = 1;
+      ++dropped;
     }
   }
+  return dropped;
+}
 
-  for (size_t i = 0; i < n; ++i) {
+// NearDynamic: whether a person keypoint with depth lies within no_depth_radius_px of p.
+bool memberNear(const ScreeningOptions& o, const Region& r, const cv::Point2f& p) {
+  const float nd2 = static_cast<float>(o.no_depth_radius_px * o.no_depth_radius_px);
+  for (size_t m = 0; m < r.pts.size(); ++m) {
+    if (!r.member[m]) continue;
+    const float dx = r.pts[m].x - p.x, dy = r.pts[m].y - p.y;
+    if (dx * dx + dy * dy < nd2) return true;
+  }
+  return false;
+}
+
+// Nearest: the label of the closest keypoint with depth within grow_radius_px (0 if none).
+uint8_t nearestLabel(const ScreeningOptions& o, const Region& r, const cv::Point2f& p) {
+  float best = static_cast<float>(o.grow_radius_px * o.grow_radius_px);
+  uint8_t label = 0;
+  for (size_t m = 0; m < r.pts.size(); ++m) {
+    const float dx = r.pts[m].x - p.x, dy = r.pts[m].y - p.y, d2 = dx * dx + dy * dy;
+    if (d2 < best) {
+      best = d2;
+      label = r.member[m];
+    }
+  }
+  return label;
+}
+
+// The no-depth rule over the region's keypoints without depth.
+void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+                 std::vector<uint8_t>& drop) {
+  using Rule = ScreeningOptions::NoDepthRule;
+  if (o.no_depth == Rule::Static) return;
+  for (int i : r.idx) {
+    if (frame.depth[i] > 0) continue;
+    const cv::Point2f p = frame.keypoints[i].pt;
+    if (r.core && !inside(*r.core, p)) continue;  // dilation ring: depth only
+    bool dynamic = true;  // Rule::Dynamic
+    if (o.no_depth == Rule::NearDynamic) dynamic = memberNear(o, r, p);
+    if (o.no_depth == Rule::Nearest) dynamic = nearestLabel(o, r, p) != 0;
+    if (dynamic) drop[i] = 1;
+  }
+}
+
+// Screens one region: its person set is dropped, then the silhouette and no-depth rules, unless
+// the flat-box rule leaves the box alone.
+void screenRegion(const Screener& s, const features::FeatureFrame& frame, Region& r,
+                  const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                  std::vector<uint8_t>& drop, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  st.iterations += findPerson(s, frame, r);
+  if (r.box && o.reject_flat_boxes && isFlatBox(o, frame, r, boxes)) {
+    ++st.flat_boxes;
+    return;  // a picture or static surface: nothing in this box is dropped
+  }
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) drop[r.with_depth[m]] = 1;
+  if (r.box && !silhouette_depth.empty())
+    st.silhouette += markSilhouette(o, frame, r, silhouette_depth, drop);
+  markNoDepth(o, frame, r, drop);
+}
+
+// Box modes: the keypoints of each dilated box (in_any) are dropped (detect) or screened.
+void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
+                 const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                 std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  Region r;
+  r.idx.reserve(frame.keypoints.size());
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    const cv::Rect2f dilated = dilate(boxes[b].rect, o.box_dilation);
+    r.index = static_cast<unsigned>(b);
+    r.box = &dilated;
+    r.core = o.dilation_depth_only ? &boxes[b].rect : nullptr;
+    r.idx.clear();
+    for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+      if (inside(dilated, frame.keypoints[i].pt)) {
+        r.idx.push_back(static_cast<int>(i));
+        in_any[i] = 1;
+      }
+    }
+    if (o.mode == DynamicMode::Detect) {
+      for (int i : r.idx) drop[i] = 1;
+    } else {
+      screenRegion(s, frame, r, boxes, silhouette_depth, drop, st);
+    }
+  }
+}
+
+// Writes the drops of the keypoints in a region into frame.dynamic and counts them.
+void applyDrops(const std::vector<uint8_t>& in_any, const std::vector<uint8_t>& drop,
+                features::FeatureFrame& frame, ScreeningStats& st) {
+  for (size_t i = 0; i < in_any.size(); ++i) {
     if (!in_any[i]) continue;
     ++st.in_boxes;
     if (drop[i]) {
@@ -463,6 +445,31 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
     } else {
       ++st.kept;
     }
+  }
+}
+
+}  // namespace
+
+ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                                const cv::Mat& depth_m) const {
+  Stopwatch sw;
+  ScreeningStats st;
+  const size_t n = frame.keypoints.size();
+  if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
+  checkDepths(opt_, frame);
+  if (opt_.mode != DynamicMode::Off) {
+    const cv::Mat silhouette_depth = silhouetteDepth(opt_, frame, depth_m);
+    std::vector<uint8_t> in_any(n, 0), drop(n, 0);
+    if (opt_.mode == DynamicMode::Geometry) {
+      // The whole image is one region.
+      Region r;
+      for (size_t i = 0; i < n; ++i) r.idx.push_back(static_cast<int>(i));
+      std::fill(in_any.begin(), in_any.end(), 1);
+      screenRegion(*this, frame, r, boxes, silhouette_depth, drop, st);
+    } else {
+      screenBoxes(*this, frame, boxes, silhouette_depth, in_any, drop, st);
+    }
+    applyDrops(in_any, drop, frame, st);
   }
   st.ms = sw.ms();
   return st;

@@ -1,6 +1,6 @@
 #include "yolo_slam/screening/temporal.h"
 
-#include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/features/match_near.h"
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/screening/screener.h"
@@ -31,45 +31,38 @@ bool isDynamic(const features::FeatureFrame& f, size_t i) {
 float depthOf(const features::FeatureFrame& f, size_t i) {
   return i < f.depth.size() ? f.depth[i] : 0.f;
 }
+
+const OptionTable<TemporalOptions>& temporalFields() {
+  using O = TemporalOptions;
+  static const OptionTable<O> table = {
+      {"Screening.propagateLabels", &O::propagate_labels},
+      {"Screening.propagateMaxAge", &O::propagate_max_age, Range::atLeast(1)},
+      {"Screening.staticBoxVeto", &O::static_box_veto},
+      {"Screening.staticBoxFraction", &O::static_box_fraction, Range::fraction()},
+      {"Screening.staticBoxMinPoints", &O::static_box_min_points, Range::atLeast(1)},
+      {"Screening.staticBoxMaxScore", &O::static_box_max_score, Range::closed(0, 1)},
+      {"Screening.temporalRadius", &O::radius_px, Range::positive()},
+      {"Screening.temporalMaxHamming", &O::max_hamming, Range::closed(0, 256)},
+      {"Screening.temporalMaxDepthChange", &O::max_depth_change_m, Range::positive()},
+      {"Screening.temporalStaticTolerance", &O::static_tolerance_px, Range::atLeast(0)},
+  };
+  return table;
+}
+
 }  // namespace
 
-TemporalOptions TemporalOptions::from(const ScreeningOptions& s) {
+TemporalOptions TemporalOptions::load(const Config& cfg) {
   TemporalOptions o;
-  o.propagate_labels = s.propagate_labels;
-  o.propagate_max_age = s.propagate_max_age;
-  o.static_box_veto = s.static_box_veto;
-  o.static_box_fraction = s.static_box_fraction;
-  o.static_box_min_points = s.static_box_min_points;
-  o.static_box_max_score = s.static_box_max_score;
-  o.box_dilation = s.box_dilation;
-  o.radius_px = s.temporal_radius_px;
-  o.max_hamming = s.temporal_max_hamming;
-  o.max_depth_change_m = s.temporal_max_depth_change_m;
-  o.static_tolerance_px = s.temporal_static_tolerance_px;
+  readOptions(cfg, o, temporalFields());
   return o;
 }
 
 void TemporalOptions::validate(const std::string& where) const {
-  auto bad = [&](const std::string& what) { throw Error(where + ": " + what); };
-  if (propagate_max_age < 1)
-    bad("propagateMaxAge must be >= 1 (frames), got " + std::to_string(propagate_max_age));
-  if (!(static_box_fraction > 0 && static_box_fraction <= 1))
-    bad("staticBoxFraction must be in (0, 1], got " + std::to_string(static_box_fraction));
-  if (!(static_box_max_score >= 0 && static_box_max_score <= 1))
-    bad("staticBoxMaxScore must be in [0, 1], got " + std::to_string(static_box_max_score));
-  if (static_box_min_points < 1)
-    bad("staticBoxMinPoints must be >= 1, got " + std::to_string(static_box_min_points));
-  if (!(radius_px > 0) || !std::isfinite(radius_px))
-    bad("temporalRadius must be > 0 (pixels), got " + std::to_string(radius_px));
-  if (max_hamming < 0 || max_hamming > 256)
-    bad("temporalMaxHamming must be in [0, 256], got " + std::to_string(max_hamming));
-  if (!(max_depth_change_m > 0) || !std::isfinite(max_depth_change_m))
-    bad("temporalMaxDepthChange must be > 0 (metres), got " + std::to_string(max_depth_change_m));
-  if (!(static_tolerance_px >= 0) || !std::isfinite(static_tolerance_px))
-    bad("temporalStaticTolerance must be >= 0 (pixels), got " + std::to_string(static_tolerance_px));
+  checkOptions(*this, where, temporalFields());
 }
 
-TemporalScreening::TemporalScreening(const TemporalOptions& options) : opt_(options) {
+TemporalScreening::TemporalScreening(const TemporalOptions& options, double box_dilation)
+    : opt_(options), box_dilation_(box_dilation) {
   opt_.validate();
 }
 
@@ -171,7 +164,7 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
   }
   if (motion_ok && opt_.static_box_veto) {
     std::vector<cv::Rect2f> regions;
-    for (const auto& b : boxes) regions.push_back(dilate(b.rect, opt_.box_dilation));
+    for (const auto& b : boxes) regions.push_back(dilate(b.rect, box_dilation_));
     std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
     for (size_t b = 0; b < regions.size(); ++b) {
       if (boxes[b].score >= opt_.static_box_max_score) continue;

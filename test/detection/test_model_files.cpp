@@ -135,7 +135,7 @@ TEST(DetectorOptions, LoadsKeysAndRejectsBadValues) {
   expectError([] { DetectorOptions::load(Config::fromString("Detector.confThreshold: 1.5\n", "x.yaml")); },
               "Detector.confThreshold");
   expectError([] { DetectorOptions::load(Config::fromString("Detector.inputWidth: 300\nDetector.inputHeight: 300\n", "x.yaml")); },
-              "multiples of 32");
+              "a multiple of 32");
   expectError([] { DetectorOptions::load(Config::fromString("Detector.threads: 0\n", "x.yaml")); },
               "Detector.threads");
 }

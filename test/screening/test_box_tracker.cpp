@@ -249,25 +249,14 @@ TEST(BoxTracker, LowScoreDetectionNotCarried) {
   EXPECT_EQ(tr2.predict(makeFrame(s, 5, 0), {}).size(), 1u);
 }
 
-TEST(BoxTracker, OptionsValidatedAndLoaded) {
+TEST(BoxTracker, OptionsValidated) {
   BoxTrackerOptions o;
   o.max_age = 0;
   EXPECT_THROW(BoxTracker{o}, Error);
   o = BoxTrackerOptions{};
   o.radius_px = -1;
   EXPECT_THROW(BoxTracker{o}, Error);
-  Config cfg = Config::fromString(
-      "%YAML:1.0\nScreening.trackBoxes: 1\nScreening.trackMaxAge: 7\nScreening.trackRadius: 25.5\n"
-      "Screening.trackMaxHamming: 60\nScreening.trackMinMatches: 3\nScreening.trackMinScore: 0.4\n",
-      "cfg.yaml");
-  screening::ScreeningOptions so = screening::ScreeningOptions::load(cfg);
-  EXPECT_TRUE(so.track_boxes);
-  BoxTrackerOptions l = BoxTrackerOptions::from(so);
-  EXPECT_EQ(l.max_age, 7);
-  EXPECT_DOUBLE_EQ(l.radius_px, 25.5);
-  EXPECT_EQ(l.max_hamming, 60);
-  EXPECT_EQ(l.min_matches, 3);
-  EXPECT_DOUBLE_EQ(l.min_score, 0.4);
+  // Every key's value: test/slam/test_options.cpp.
   Config bad = Config::fromString("%YAML:1.0\nScreening.trackMaxAge: 0\n", "bad.yaml");
   try {
     screening::ScreeningOptions::load(bad);

@@ -36,7 +36,7 @@ TEST(BoxTrackingSequence, RecallRisesOnWalkingRpy) {
   features::OrbExtractor orb{features::OrbOptions{}};
   screening::ScreeningOptions sopt;  // defaults: detect+geometry
   screening::Screener screener(sopt);
-  screening::BoxTracker tracker(screening::BoxTrackerOptions::from(sopt));
+  screening::BoxTracker tracker(sopt.tracker);
 
   screening::ScreeningMetrics without, with;
   size_t missed = 0, carried = 0;

@@ -89,6 +89,9 @@ int countDynamic(const features::FeatureFrame& f, const World& w, bool person) {
   return n;
 }
 
+// The boxes of these scenes are the regions screened, as they are.
+constexpr double kBoxDilation = 0;
+
 TemporalOptions propagation() {
   TemporalOptions o;
   o.propagate_labels = true;
@@ -108,7 +111,7 @@ detection::Box box(const cv::Rect2f& r, float score) {
 
 TEST(Temporal, StaticSceneIsStaticConsistentUnderCameraMotion) {
   const World w = makeWorld(200, 0, 0, 1);
-  TemporalScreening ts(propagation());
+  TemporalScreening ts(propagation(), kBoxDilation);
   features::FeatureFrame f0 = render(w, 0.0, 0, false);
   ASSERT_EQ(f0.size(), w.points.size());
   ts.apply(f0, {}, camera());
@@ -127,7 +130,7 @@ TEST(Temporal, StaticSceneIsStaticConsistentUnderCameraMotion) {
 
 TEST(Temporal, LabelsOfAMovingPersonPropagateWhereTheDetectorMissedThem) {
   const World w = makeWorld(200, 60, 0.3, 2);
-  TemporalScreening ts(propagation());
+  TemporalScreening ts(propagation(), kBoxDilation);
   features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
   ASSERT_EQ(f0.size(), w.points.size());
   ts.apply(f0, {}, camera());
@@ -143,7 +146,7 @@ TEST(Temporal, LabelsOfAMovingPersonPropagateWhereTheDetectorMissedThem) {
 
 TEST(Temporal, WronglyDroppedBackgroundDoesNotPropagate) {
   const World w = makeWorld(300, 0, 0, 3);
-  TemporalScreening ts(propagation());
+  TemporalScreening ts(propagation(), kBoxDilation);
   // A false detection dropped the wall keypoints in this box in frame 0 only.
   features::FeatureFrame f0 = render(w, 0.0, 0, false, cv::Rect2f(100, 100, 200, 200));
   const int dropped0 = static_cast<int>(f0.countDynamic());
@@ -160,7 +163,7 @@ TEST(Temporal, LabelsStopAfterMaxAgeFramesWithoutScreening) {
   const World w = makeWorld(200, 60, 0.2, 4);
   TemporalOptions o = propagation();
   o.propagate_max_age = 2;
-  TemporalScreening ts(o);
+  TemporalScreening ts(o, kBoxDilation);
   features::FeatureFrame f = render(w, 0.0, 0.0, true);
   ts.apply(f, {}, camera());
   std::vector<int> marked;
@@ -199,12 +202,11 @@ VetoScene vetoScene(TemporalScreening& ts) {
 TemporalOptions vetoOnly() {
   TemporalOptions o;
   o.static_box_veto = true;
-  o.box_dilation = 0;
   return o;
 }
 
 TEST(Temporal, StaticBoxVetoKeepsAnUnsureFalseDetectionButNotAWalkingPerson) {
-  TemporalScreening ts(vetoOnly());
+  TemporalScreening ts(vetoOnly(), kBoxDilation);
   VetoScene v = vetoScene(ts);
   features::FeatureFrame& f1 = v.f1;
   const World& w = v.w;
@@ -223,7 +225,7 @@ TEST(Temporal, StaticBoxVetoKeepsAnUnsureFalseDetectionButNotAWalkingPerson) {
 
 TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
   // A seated person is as still as a picture; the detector is sure of people, not of pictures.
-  TemporalScreening ts(vetoOnly());
+  TemporalScreening ts(vetoOnly(), kBoxDilation);
   VetoScene v = vetoScene(ts);
   const int wall_dropped = countDynamic(v.f1, v.w, false);
   const TemporalStats st = ts.apply(v.f1, {box(v.picture, 0.95f), box(v.person, 0.95f)}, camera());
@@ -235,7 +237,7 @@ TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
 TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
   // Too few static keypoints with depth: the motion is unknown, so no label can be judged.
   const World w = makeWorld(8, 60, 0.0, 6);
-  TemporalScreening ts(propagation());
+  TemporalScreening ts(propagation(), kBoxDilation);
   features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
   ts.apply(f0, {}, camera());
   features::FeatureFrame f1 = render(w, 0.01, 0.05, false);
@@ -247,7 +249,7 @@ TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
 
 TEST(Temporal, ClearForgetsThePreviousFrame) {
   const World w = makeWorld(200, 60, 0.3, 7);
-  TemporalScreening ts(propagation());
+  TemporalScreening ts(propagation(), kBoxDilation);
   features::FeatureFrame f0 = render(w, 0.0, 0.0, true);
   ts.apply(f0, {}, camera());
   ts.clear();
@@ -262,7 +264,7 @@ TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
       "%YAML:1.0\nScreening.propagateLabels: 1\nScreening.propagateMaxAge: 5\n"
       "Screening.staticBoxVeto: 0\nScreening.staticBoxFraction: 0.7\n"
       "Screening.temporalStaticTolerance: 4\n");
-  const TemporalOptions o = TemporalOptions::from(screening::ScreeningOptions::load(cfg));
+  const TemporalOptions o = screening::ScreeningOptions::load(cfg).temporal;
   EXPECT_TRUE(o.propagate_labels);
   EXPECT_EQ(o.propagate_max_age, 5);
   EXPECT_FALSE(o.static_box_veto);
@@ -277,5 +279,5 @@ TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
   }
   TemporalOptions bad;
   bad.propagate_max_age = 0;
-  EXPECT_THROW(TemporalScreening{bad}, Error);
+  EXPECT_THROW((TemporalScreening{bad, kBoxDilation}), Error);
 }

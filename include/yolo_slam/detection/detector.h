@@ -52,8 +52,10 @@ struct DetectorOptions {
   // Keys: Detector.model, Detector.extraModels (a list; "" or [""] for none),
   // Detector.inputWidth, Detector.inputHeight, Detector.letterbox, Detector.confThreshold,
   // Detector.nmsThreshold, Detector.threads, Detector.dynamicClasses.
-  // Throws yolo_slam::Error naming the key on out-of-range values.
+  // Throws yolo_slam::Error naming the file and key on out-of-range values.
   static DetectorOptions load(const Config& cfg);
+  // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
+  void validate(const std::string& where = "DetectorOptions") const;
 };
 
 class Detector {

@@ -23,11 +23,13 @@
 #include <vector>
 
 namespace yolo_slam {
+
+class Config;
+
 namespace screening {
 
-struct ScreeningOptions;
-
 struct BoxTrackerOptions {
+  bool enabled = true;  // Screening.trackBoxes: track at all (modes with boxes only)
   // A track lives at most this many consecutive frames without a detection. Each carried frame
   // compounds the error of the box (the person also changes shape), so it is kept short.
   int max_age = 5;
@@ -49,10 +51,10 @@ struct BoxTrackerOptions {
   // (the detector's box changed shape too much for the IoU test): no duplicate box.
   double covered_fraction = 0.7;
 
-  // The tracker's fields of ScreeningOptions (Screening.trackMaxAge, trackRadius,
-  // trackMaxHamming, trackMinMatches, trackMinScore).
-  static BoxTrackerOptions from(const ScreeningOptions& s);
-  // Throws yolo_slam::Error (prefixed by `where`) for out-of-range values.
+  // Reads Screening.trackBoxes, trackMaxAge (frames), trackRadius (px), trackMaxHamming (bits),
+  // trackMinMatches, trackMinScore; throws yolo_slam::Error naming the file and key.
+  static BoxTrackerOptions load(const Config& cfg);
+  // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "BoxTrackerOptions") const;
 };
 

@@ -8,6 +8,8 @@
 #include "yolo_slam/common/json.h"
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/screening/box_tracker.h"
+#include "yolo_slam/screening/temporal.h"
 
 #include <opencv2/core.hpp>
 
@@ -57,12 +59,12 @@ struct ScreeningOptions {
   double probability = 0.99;  // P of Eq. 7-8
   int max_iterations = 500;   // cap on k (k starts unbounded)
   unsigned seed = 0;          // RNG seed: screening is deterministic given the seed
-  // Rule for in-box keypoints without valid depth (depth <= 0): Dynamic (depth holes in a
-  // person box sit mostly on the person's silhouette and hair), Static, or Nearest: the label
-  // of the nearest in-box keypoint with depth (within grow_radius_px; static if none).
-  // NearDynamic: dynamic when a keypoint with depth declared dynamic lies within
-  // no_depth_radius_px, static otherwise (holes on a person's outline have dynamic neighbours;
-  // far background beyond the sensor's range has none).
+  // Rule for in-box keypoints without valid depth (depth <= 0), Screening.noDepth:
+  // Dynamic (depth holes in a person box sit mostly on the person's silhouette and hair);
+  // Static; Nearest: the label of the nearest in-box keypoint with depth (within
+  // grow_radius_px; static if none); NearDynamic (the default): dynamic when a keypoint with
+  // depth declared dynamic lies within no_depth_radius_px, static otherwise (holes on a
+  // person's outline have dynamic neighbours; far background beyond the sensor's range has none).
   enum class NoDepthRule { Dynamic, Static, Nearest, NearDynamic };
   NoDepthRule no_depth = NoDepthRule::NearDynamic;
   // Grow each box by this fraction of its width/height per side: detector boxes clip heads
@@ -93,48 +95,24 @@ struct ScreeningOptions {
   double flat_box_fraction = 0.4;
   double flat_box_tolerance = 0.01;
   double flat_box_ring = 0.25;
-  // Box tracking between detections (screening::BoxTracker, beyond the paper): people the
-  // detector misses in a frame keep a box moved by their keypoints' motion. Modes detect and
-  // detect+geometry only. Keys Screening.trackBoxes, trackMaxAge (frames), trackRadius (px),
-  // trackMaxHamming (bits), trackMinMatches, trackMinScore; meaning in box_tracker.h.
-  bool track_boxes = true;
-  int track_max_age = 5;
-  double track_radius_px = 40;
-  int track_max_hamming = 50;
-  int track_min_matches = 5;
-  double track_min_score = 0.5;  // Screening.trackMinScore: last detection's score to carry
-  // Frame-to-frame evidence (screening::TemporalScreening in temporal.h, beyond the paper):
-  // label propagation (Screening.propagateLabels, propagateMaxAge) and the static-box veto
-  // (Screening.staticBoxVeto, staticBoxFraction, staticBoxMinPoints, staticBoxMaxScore);
-  // matching and the static
-  // test: temporalRadius (px),
-  // temporalMaxHamming (bits), temporalMaxDepthChange (m), temporalStaticTolerance (px).
-  bool propagate_labels = false;
-  int propagate_max_age = 3;
-  bool static_box_veto = true;
-  double static_box_fraction = 0.8;
-  int static_box_min_points = 10;
-  double static_box_max_score = 0.8;
-  double temporal_radius_px = 30;
-  int temporal_max_hamming = 50;
-  double temporal_max_depth_change_m = 0.2;
-  double temporal_static_tolerance_px = 3;
+  // Box tracking between detections (box_tracker.h, beyond the paper): Screening.trackBoxes,
+  // trackMaxAge, trackRadius, trackMaxHamming, trackMinMatches, trackMinScore.
+  BoxTrackerOptions tracker;
+  // Frame-to-frame evidence (temporal.h, beyond the paper): label propagation
+  // (Screening.propagateLabels, propagateMaxAge), the static-box veto (staticBoxVeto,
+  // staticBoxFraction, staticBoxMinPoints, staticBoxMaxScore), and the matching and static
+  // test both use (temporalRadius, temporalMaxHamming, temporalMaxDepthChange,
+  // temporalStaticTolerance).
+  TemporalOptions temporal;
 
-  // Reads Screening.mode, Screening.variant, Screening.varianceThreshold (m^2),
-  // Screening.probability, Screening.maxIterations, Screening.seed, Screening.noDepth
-  // ("dynamic" | "static" | "nearest"), Screening.boxDilation, Screening.growRadius (px),
-  // Screening.growDepth (m), Screening.clusterMinFraction, Screening.noDepthRadius (px),
-  // Screening.dilationDepthOnly (bool), Screening.rejectFlatBoxes (bool), flatBoxFraction,
-  // flatBoxTolerance (1/m), flatBoxRing, Screening.trackBoxes (bool), trackMaxAge,
-  // trackRadius, trackMaxHamming, trackMinMatches, trackMinScore, Screening.propagateLabels
-  // (bool), propagateMaxAge, staticBoxVeto (bool), staticBoxFraction, staticBoxMinPoints,
-  // staticBoxMaxScore,
-  // temporalRadius, temporalMaxHamming,
-  // temporalMaxDepthChange, temporalStaticTolerance.
-  // Invalid values throw
-  // yolo_slam::Error naming the file and key.
+  // Reads Screening.mode, variant, varianceThreshold (m^2), probability, maxIterations, seed,
+  // noDepth (dynamic | static | nearest | near-dynamic), noDepthRadius (px), silhouetteRadius
+  // (px), boxDilation, growRadius (px), growDepth (m), clusterMinFraction, dilationDepthOnly,
+  // rejectFlatBoxes, flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing, then the keys of
+  // `tracker` and `temporal`. Invalid values throw yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
-  // Throws yolo_slam::Error (prefixed by `where`) if a value is out of range.
+  // The loader's rules, for options set in code (tracker and temporal included); throws
+  // yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "ScreeningOptions") const;
 };
 
@@ -242,7 +220,8 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
                                    const detection::Boxes& boxes, int ignore_border_px = 0);
 
 // Reads a ground-truth mask PNG (8-bit, 0 static / 255 person / 128-254 other dynamic; colour
-// images are converted to grey). Throws yolo_slam::Error naming the file if it is missing or unreadable.
+// images are converted to grey). Throws yolo_slam::Error naming the file if it is missing or
+// unreadable.
 cv::Mat loadMask(const std::string& path);
 
 }  // namespace screening

@@ -31,9 +31,10 @@
 #include <vector>
 
 namespace yolo_slam {
-namespace screening {
 
-struct ScreeningOptions;
+class Config;
+
+namespace screening {
 
 struct TemporalOptions {
   bool propagate_labels = false;
@@ -43,7 +44,6 @@ struct TemporalOptions {
   double static_box_fraction = 0.8;  // share of a box's tested dropped keypoints
   int static_box_min_points = 10;    // fewer tested keypoints: no verdict, the box stays
   double static_box_max_score = 0.8;  // boxes scored at least this are never vetoed
-  double box_dilation = 0.05;        // Screening.boxDilation: the region the screener used
   // Pixel radius of the search around a keypoint's position in the previous frame (a walking
   // person moves tens of pixels per frame at 30 Hz).
   double radius_px = 30;
@@ -56,11 +56,12 @@ struct TemporalOptions {
   double static_tolerance_px = 3;
 
   bool enabled() const { return propagate_labels || static_box_veto; }
-  // The fields of ScreeningOptions (Screening.propagateLabels, propagateMaxAge, staticBoxVeto,
-  // staticBoxFraction, staticBoxMinPoints, staticBoxMaxScore, temporalRadius, temporalMaxHamming,
-  // temporalMaxDepthChange, temporalStaticTolerance, boxDilation).
-  static TemporalOptions from(const ScreeningOptions& s);
-  // Throws yolo_slam::Error (prefixed by `where`) for out-of-range values.
+  // Reads Screening.propagateLabels, propagateMaxAge, staticBoxVeto, staticBoxFraction,
+  // staticBoxMinPoints, staticBoxMaxScore, temporalRadius (px), temporalMaxHamming (bits),
+  // temporalMaxDepthChange (m), temporalStaticTolerance (px); throws yolo_slam::Error naming
+  // the file and key.
+  static TemporalOptions load(const Config& cfg);
+  // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "TemporalOptions") const;
 };
 
@@ -83,7 +84,9 @@ void to_json(Json& j, const TemporalStats& s);
 // One per camera stream; deterministic. Not thread-safe: the caller serialises frames.
 class TemporalScreening {
  public:
-  explicit TemporalScreening(const TemporalOptions& options);  // validates
+  // box_dilation: the screener's Screening.boxDilation, so the veto tests the regions it
+  // screened. Validates the options.
+  TemporalScreening(const TemporalOptions& options, double box_dilation);
   const TemporalOptions& options() const { return opt_; }
 
   // After Screener::screen on `frame` with `boxes`: the static-box veto, then label
@@ -103,6 +106,7 @@ class TemporalScreening {
                           const CameraModel& cam, cv::Matx33d& R, cv::Vec3d& t, int* n_inliers);
 
   TemporalOptions opt_;
+  double box_dilation_;
   features::FeatureFrame prev_;     // keypoints, descriptors, depth, dynamic of the last frame
   std::vector<cv::Point3f> prev_X_;  // its keypoints in its camera frame (z <= 0: no depth)
   std::vector<int> prev_age_;        // label age per keypoint (0: screened or static)
