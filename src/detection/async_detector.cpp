@@ -2,9 +2,9 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
 
-#include <cmath>
 
 namespace yolo_slam {
 namespace detection {
@@ -12,10 +12,7 @@ namespace detection {
 AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
   AsyncDetectionOptions o;
   o.enabled = cfg.getBool("Detection.async", o.enabled);
-  o.max_age_s = cfg.getDouble("Detection.maxAge", o.max_age_s);
-  if (!(o.max_age_s >= 0) || !std::isfinite(o.max_age_s))
-    throw Error((cfg.path().empty() ? std::string("<config>") : cfg.path()) +
-                ": key 'Detection.maxAge' must be >= 0 seconds (got " + std::to_string(o.max_age_s) + ")");
+  o.max_age_s = readDouble(cfg, "Detection.maxAge", o.max_age_s, Range::atLeast(0));
   return o;
 }
 

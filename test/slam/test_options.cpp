@@ -6,6 +6,7 @@
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/paths.h"
+#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/detection/detector.h"
 #include "yolo_slam/slam/system.h"
 
@@ -51,6 +52,8 @@ Detector.confThreshold: 0.375
 Detector.nmsThreshold: 0.5
 Detector.threads: 3
 Detector.dynamicClasses: [ "person" ]
+Detection.async: 0
+Detection.maxAge: 0.375
 Screening.mode: "detect"
 Screening.variant: "grow"
 Screening.varianceThreshold: 0.03125
@@ -130,6 +133,7 @@ std::set<std::string> topLevelKeys(const cv::FileStorage& fs) {
 void loadOptions(const Config& cfg) {
   slam::SystemOptions::load(cfg);
   detection::DetectorOptions::load(cfg);
+  detection::AsyncDetectionOptions::load(cfg);
 }
 
 const std::string kTum3 = joinPath(YOLO_SLAM_SOURCE_DIR, "config/TUM3.yaml");
@@ -181,6 +185,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(d.input_width, d.input_height, d.letterbox, d.conf_threshold, d.nms_threshold, d.threads),
             std::make_tuple(320, 256, false, 0.375f, 0.5f, 3));
   EXPECT_EQ(d.dynamic_classes, std::vector<std::string>{"person"});
+  const detection::AsyncDetectionOptions a = detection::AsyncDetectionOptions::load(cfg);
+  EXPECT_EQ(std::tie(a.enabled, a.max_age_s), std::make_tuple(false, 0.375));
 
   const screening::ScreeningOptions& s = sys.screening;
   using screening::DynamicMode;
@@ -305,6 +311,8 @@ TEST(Options, RejectionsNameFileKeyRuleAndValue) {
             "bad.yaml: key 'Detector.threads' must be >= 1 (got 0)");
   EXPECT_EQ(detectorRejection("Detector.inputWidth", "100"),
             "bad.yaml: key 'Detector.inputWidth' must be a multiple of 32 (got 100)");
+  EXPECT_EQ(rejection("Detection.maxAge", "-1", [](const Config& c) { detection::AsyncDetectionOptions::load(c); }),
+            "bad.yaml: key 'Detection.maxAge' must be >= 0 (got -1)");
   EXPECT_EQ(detectorRejection("Detector.dynamicClasses", "[]"),
             "bad.yaml: key 'Detector.dynamicClasses' must be a list of at least one class name (got [])");
 }
