@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/slam/types.h"
 
 namespace yolo_slam {
 namespace slam {
@@ -63,7 +64,9 @@ LoopClosingOptions LoopClosingOptions::load(const Config& cfg) {
   o.min_matches = positiveInt(cfg, "LoopClosing.minMatches", o.min_matches, 10);
   o.max_correction_m = rangeDouble(cfg, "LoopClosing.maxCorrectionM", o.max_correction_m, 0.0, 1e6);
   o.max_correction_deg = rangeDouble(cfg, "LoopClosing.maxCorrectionDeg", o.max_correction_deg, 0.0, 180.0);
-  o.covisibility_weight = positiveInt(cfg, "LoopClosing.covisibilityWeight", o.covisibility_weight, 15);
+  // Weaker pairs have no covisibility edge to take into the essential graph.
+  o.covisibility_weight =
+      positiveInt(cfg, "LoopClosing.covisibilityWeight", o.covisibility_weight, kCovisibilityMinWeight);
   o.pose_graph_iterations = positiveInt(cfg, "LoopClosing.poseGraphIterations", o.pose_graph_iterations, 1);
   o.global_ba = cfg.getBool("LoopClosing.globalBA", o.global_ba);
   o.global_ba_iterations = positiveInt(cfg, "LoopClosing.globalBAIterations", o.global_ba_iterations, 1);
