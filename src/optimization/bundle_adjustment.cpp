@@ -19,13 +19,6 @@ namespace optimization {
 
 namespace {
 
-// Iterations of the two stages of local BA (ORB-SLAM2 LocalBundleAdjustment: 5 robust, then 10
-// without the kernel and the outliers).
-constexpr int kLocalRobustIterations = 5;
-constexpr int kLocalRefineIterations = 10;
-// Above this many free poses the sparse Schur solver beats the dense one (this project's choice).
-constexpr int kMaxDensePoses = 60;
-
 using StopFn = std::function<bool()>;
 
 class StopCallback final : public ceres::IterationCallback {
@@ -136,6 +129,9 @@ std::shared_ptr<ceres::ParameterBlockOrdering> schurOrdering(Workspace& w, const
   }
   return ordering;
 }
+
+// Above this many free poses the sparse Schur solver beats the dense one (this project's choice).
+constexpr int kMaxDensePoses = 60;
 
 // One Ceres solve over the observations with include[i] set. Returns the iterations used.
 int solveStage(const Intrinsics& K, Workspace& w, const BaProblem& p,
@@ -252,6 +248,11 @@ BaResult runBa(const CameraModel& cam, BaProblem& p, int first_iterations, int s
   writeBack(w, p, point_observed);
   return res;
 }
+
+// Iterations of the two stages of local BA (ORB-SLAM2 LocalBundleAdjustment: 5 robust, then 10
+// without the kernel and the outliers).
+constexpr int kLocalRobustIterations = 5;
+constexpr int kLocalRefineIterations = 10;
 
 }  // namespace
 

@@ -149,27 +149,6 @@ void LocalMapping::processFront(std::unique_lock<std::mutex>& lk) {
 
 namespace {
 
-// ORB-SLAM2 LocalMapping values for stereo/RGB-D.
-// MapPointCulling: a new point goes if found in less than this share of the frames that should
-// see it, or if this many keyframes after its creation it has at most kCullMaxObservations
-// (weighted) observations; after kKeepAfterKeyFrames it has proven itself.
-constexpr double kMinFoundRatio = 0.25;
-constexpr long kCullAfterKeyFrames = 2;
-constexpr int kCullMaxObservations = 3;
-constexpr long kKeepAfterKeyFrames = 3;
-// CreateNewMapPoints: distance ratio against octave ratio tolerance (x scale factor), rays more
-// parallel than this cosine are not triangulated without depth, chi2 of the reprojection
-// (2 dof 95% and ORB-SLAM2's 7.8 for 3 dof).
-constexpr double kScaleConsistency = 1.5;
-constexpr double kMaxParallaxCos = 0.9998;
-constexpr double kTriangulationChi2Mono = 5.991;
-constexpr double kTriangulationChi2Stereo = 7.8;
-// SearchInNeighbors: covisibles of each neighbour added to the fusion targets.
-constexpr size_t kFuseSecondNeighbours = 5;
-// KeyFrameCulling: a point is redundant when this many other keyframes see it at the same or a
-// finer scale.
-constexpr int kRedundantObservers = 3;
-
 bool queueEmpty(std::mutex& m, const std::deque<KeyFramePtr>& q) {
   std::lock_guard<std::mutex> lk(m);
   return q.empty();
@@ -224,6 +203,14 @@ void LocalMapping::processNewKeyFrame() {
 }
 
 void LocalMapping::mapPointCulling() {
+  // ORB-SLAM2 MapPointCulling (stereo/RGB-D): a new point goes if found in less than this share
+  // of the frames that should see it, or if kCullAfterKeyFrames keyframes after its creation it
+  // has at most kCullMaxObservations (weighted) observations; after kKeepAfterKeyFrames it
+  // has proven itself.
+  constexpr double kMinFoundRatio = 0.25;
+  constexpr long kCullAfterKeyFrames = 2;
+  constexpr int kCullMaxObservations = 3;
+  constexpr long kKeepAfterKeyFrames = 3;
   const long cur = current_->id;
   for (auto it = recent_points_.begin(); it != recent_points_.end();) {
     const MapPointPtr& mp = *it;
@@ -263,6 +250,14 @@ bool triangulate(const Eigen::Vector3d& xn1, const Eigen::Vector3d& xn2, const P
 }  // namespace
 
 namespace {
+
+// ORB-SLAM2 CreateNewMapPoints: distance ratio against octave ratio tolerance (x scale factor),
+// rays more parallel than this cosine are not triangulated without depth, chi2 bounds of the
+// reprojection (2 dof 95%, and ORB-SLAM2's 7.8 for 3 dof).
+constexpr double kScaleConsistency = 1.5;
+constexpr double kMaxParallaxCos = 0.9998;
+constexpr double kTriangulationChi2Mono = 5.991;
+constexpr double kTriangulationChi2Stereo = 7.8;
 
 // One keyframe of a triangulation pair.
 struct View {
@@ -367,6 +362,8 @@ void LocalMapping::searchInNeighbors() {
     if (kf->bad || !seen.insert(kf->id).second) continue;
     targets.push_back(kf);
   }
+  // ORB-SLAM2 SearchInNeighbors: the best covisibles of each neighbour are targets too.
+  constexpr size_t kFuseSecondNeighbours = 5;
   const size_t n1 = targets.size();
   for (size_t k = 0; k < n1; ++k)
     for (const auto& kf2 : targets[k]->bestCovisibles(kFuseSecondNeighbours))
@@ -476,7 +473,9 @@ void LocalMapping::localBundleAdjustment() {
 void LocalMapping::keyFrameCulling() {
   if (current_->bad) return;
   const double close = cam_.closeDepth();
-  const int th_obs = kRedundantObservers;
+  // ORB-SLAM2 KeyFrameCulling: a point is redundant when this many other keyframes see it at
+  // the same or a finer scale.
+  const int th_obs = 3;
   std::vector<KeyFramePtr> local = current_->ordered_connections;
   for (const auto& kf : local) {
     if (kf->bad || kf->is_origin || kf->not_erase) continue;

@@ -135,6 +135,15 @@ bool LoopClosing::processOne(const KeyFramePtr& kf) {
 // ---------------------------------------------------------------------------------------------
 // Detection (ORB-SLAM2 DetectLoop / KeyFrameDatabase::DetectLoopCandidates).
 
+namespace {
+// Whether ids and prev (sorted) share an id.
+bool overlaps(const std::vector<long>& ids, const std::vector<long>& prev) {
+  for (long id : ids)
+    if (std::binary_search(prev.begin(), prev.end(), id)) return true;
+  return false;
+}
+}  // namespace
+
 std::vector<KeyFramePtr> LoopClosing::detectLoop(const KeyFramePtr& kf) {
   vocabulary::KeyFrameDatabase* db = map_.keyFrameDatabase();
   if (!db || kf->f.bow.empty()) return {};
@@ -162,10 +171,12 @@ std::vector<KeyFramePtr> LoopClosing::detectLoop(const KeyFramePtr& kf) {
   const auto hits = db->query(kf->f.bow.bow, 0, q);
 
   // Group each hit with its best covisibles; keep groups scoring > 0.75 x the best.
-  const std::vector<KeyFramePtr> cands = covisibilityGroupCandidates(map_, hits);
+  return consistentCandidates(covisibilityGroupCandidates(map_, hits));
+}
 
-  // Temporal consistency: a candidate's group (itself + covisibles) must overlap a group that
-  // was already consistent for the previous keyframe; `consistency` keyframes in a row.
+std::vector<KeyFramePtr> LoopClosing::consistentCandidates(const std::vector<KeyFramePtr>& cands) {
+  // A candidate's group (itself + covisibles) must overlap a group that was already consistent
+  // for the previous keyframe; `consistency` keyframes in a row.
   std::vector<ConsistentGroup> next;
   std::vector<KeyFramePtr> enough;
   std::vector<bool> group_extended(groups_.size(), false);
@@ -176,14 +187,7 @@ std::vector<KeyFramePtr> LoopClosing::detectLoop(const KeyFramePtr& kf) {
     std::sort(g.kfs.begin(), g.kfs.end());
     bool consistent_for_any = false, added = false;
     for (size_t i = 0; i < groups_.size(); ++i) {
-      const auto& prev = groups_[i].kfs;
-      bool overlap = false;
-      for (long id : g.kfs)
-        if (std::binary_search(prev.begin(), prev.end(), id)) {
-          overlap = true;
-          break;
-        }
-      if (!overlap) continue;
+      if (!overlaps(g.kfs, groups_[i].kfs)) continue;
       consistent_for_any = true;
       const int count = groups_[i].count + 1;
       if (!group_extended[i]) {
@@ -208,23 +212,6 @@ std::vector<KeyFramePtr> LoopClosing::detectLoop(const KeyFramePtr& kf) {
 
 namespace {
 
-// Nearest-neighbour ratio of SearchByBoW between keyframes (ORB-SLAM2 ComputeSim3: 0.75).
-constexpr float kBowRatio = 0.75f;
-// An inlier reprojects within chi2(2 dof, 99%) in both keyframes (ORB-SLAM2 Sim3Solver: 9.21).
-constexpr double kChi2Inlier = 9.21;
-// RANSAC iterations (ORB-SLAM2 ComputeSim3: 300); a hypothesis explaining this share of the
-// matches ends the search early (this project's choice).
-constexpr int kRansacIterations = 300;
-constexpr double kRansacEnoughShare = 0.9;
-// Projection search of the loop side's points: minimum viewing cosine (ORB-SLAM2: 0.5), window
-// and nearest-neighbour ratio (this project's choice).
-constexpr double kLoopViewCos = 0.5;
-constexpr double kLoopWindow = 1.0;
-constexpr double kLoopRatio = 0.9;
-// Window of the fusion of the loop side's points into the corrected neighbourhood (ORB-SLAM2
-// SearchAndFuse: 4).
-constexpr double kLoopFuseWindow = 4.0;
-
 struct Match3D {
   size_t i1, i2;             // keypoint in current / in candidate
   MapPointPtr mp1, mp2;
@@ -236,6 +223,9 @@ struct Se3Fit {
   Pose T12 = Pose::Identity();
   int inliers = 0;
 };
+
+// An inlier reprojects within chi2(2 dof, 99%) in both keyframes (ORB-SLAM2 Sim3Solver: 9.21).
+constexpr double kChi2Inlier = 9.21;
 
 bool reprojOk(const CameraModel& cam, const Frame& f, size_t idx, const Eigen::Vector3d& Pc) {
   if (!(Pc.z() > 0)) return false;
@@ -274,6 +264,9 @@ std::vector<uint8_t> usableWithPoint(const KeyFrame& kf) {
   }
   return u;
 }
+
+// Nearest-neighbour ratio of SearchByBoW between keyframes (ORB-SLAM2 ComputeSim3: 0.75).
+constexpr float kBowRatio = 0.75f;
 
 // SearchByBoW between the current keyframe and a candidate, kept where both keypoints have
 // distinct map points. n_bow: the BoW matches before that.
@@ -315,6 +308,11 @@ int se3Inliers(const CameraModel& cam, const Frame& f1, const Frame& f2, const s
   }
   return n;
 }
+
+// RANSAC iterations (ORB-SLAM2 ComputeSim3: 300); a hypothesis explaining this share of the
+// matches ends the search early (this project's choice).
+constexpr int kRansacIterations = 300;
+constexpr double kRansacEnoughShare = 0.9;
 
 // 3-point RANSAC on P1 = T12 * P2 (Umeyama/Horn on the samples).
 Se3Fit ransacSE3(const CameraModel& cam, const Frame& f1, const Frame& f2, const std::vector<Match3D>& m,
@@ -378,6 +376,12 @@ std::vector<MapPointPtr> loopSidePoints(const KeyFramePtr& cand) {
   }
   return loop_points;
 }
+
+// Projection search of the loop side's points: minimum viewing cosine (ORB-SLAM2: 0.5), window
+// and nearest-neighbour ratio (this project's choice).
+constexpr double kLoopViewCos = 0.5;
+constexpr double kLoopWindow = 1.0;
+constexpr double kLoopRatio = 0.9;
 
 // Projection search of the loop points not matched yet into F; returns F's matches in all.
 int searchLoopPoints(Frame& F, const std::vector<MapPointPtr>& loop_points) {
@@ -550,6 +554,8 @@ void LoopClosing::fuseCurrentMatches(const KeyFramePtr& kf) {
 }
 
 void LoopClosing::fuseLoopPoints(const std::vector<KeyFramePtr>& neighbourhood) {
+  // Window of ORB-SLAM2 SearchAndFuse.
+  constexpr double kLoopFuseWindow = 4.0;
   std::vector<MapPointPtr> loop_points;
   for (const auto& mp : loop_points_) {
     MapPointPtr p = MapPoint::resolve(mp);

@@ -48,8 +48,9 @@ constexpr double kProjectionRatio = 0.9;   // projection searches against one ke
 constexpr size_t kLostCovisibles = 10;
 constexpr int kLostMinMapMatches = 30;
 // Relocalisation: candidates tried (this project's cap on the cost of a lost frame), SearchByBoW
-// ratio, PnP RANSAC (ORB-SLAM2 PnPsolver: 300 iterations, 5.991 px^2 error, 0.99 confidence,
-// 10 inliers), inliers to accept (50), to retry with the narrow window (30), windows (10, 3).
+// ratio, PnP RANSAC (ORB-SLAM2 PnPsolver: 300 iterations, 0.99 confidence, 10 inliers; its chi2
+// bound 5.991 serves as OpenCV's pixel error), inliers to accept (50), to retry with the narrow
+// window (30), windows (10, 3).
 constexpr size_t kMaxRelocCandidates = 20;
 constexpr double kRelocBowRatio = 0.75;
 constexpr int kPnpIterations = 300;
@@ -92,6 +93,12 @@ void releaseOutliers(Frame& F) {
       F.points[i].reset();
       F.outlier[i] = false;
     }
+}
+
+// Drops F's associations to points erased or fused by local mapping.
+void dropBadPoints(Frame& F) {
+  for (auto& mp : F.points)
+    if (mp && mp->bad) mp.reset();
 }
 
 void clearAssociations(Frame& F) {
@@ -495,16 +502,11 @@ bool Tracking::pnpPose(Frame& F) const {
 void Tracking::updateLocalMap(Frame& F) {
   // Local keyframes: those sharing points with the frame, plus their best covisibles,
   // a child and the parent (ORB-SLAM2 UpdateLocalKeyFrames).
+  dropBadPoints(F);
   std::map<KeyFramePtr, int, ById> counter;
-  for (int i = 0; i < F.N; ++i) {
-    MapPointPtr& mp = F.points[i];
-    if (!mp) continue;
-    if (mp->bad) {
-      mp.reset();
-      continue;
-    }
-    for (const auto& o : mp->observations) counter[o.first]++;
-  }
+  for (const auto& mp : F.points)
+    if (mp)
+      for (const auto& o : mp->observations) counter[o.first]++;
   if (counter.empty()) return;
   local_kfs_.clear();
   std::set<long> in_local;
@@ -550,13 +552,9 @@ void Tracking::updateLocalMap(Frame& F) {
 }
 
 void Tracking::searchLocalPoints(Frame& F) {
-  for (int i = 0; i < F.N; ++i) {
-    MapPointPtr& mp = F.points[i];
+  dropBadPoints(F);
+  for (const auto& mp : F.points) {
     if (!mp) continue;
-    if (mp->bad) {
-      mp.reset();
-      continue;
-    }
     mp->visible++;
     mp->last_seen_frame = F.id;
   }

@@ -87,12 +87,14 @@ class LoopClosing {
   // released while processing).
   void processFront(std::unique_lock<std::mutex>& lk);
   struct Neighbourhood;
-  using Links = std::vector<std::pair<long, long>>;
+  using Links = std::vector<std::pair<long, long>>;   // (keyframe id, keyframe id)
 
-  std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);   // caller holds update_mutex
+  // Detection and verification: the caller holds update_mutex.
+  std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);
+  // The candidates whose covisibility group continues a consistent group (updates groups_).
+  std::vector<KeyFramePtr> consistentCandidates(const std::vector<KeyFramePtr>& cands);
   // Verification of the candidates in turn; the first that passes is kept in matched_kf_,
-  // T_cw_corrected_, current_matches_ and loop_points_. Caller holds update_mutex (so do all
-  // helpers below up to startGlobalBA, unless said otherwise).
+  // T_cw_corrected_, current_matches_ and loop_points_.
   bool computeSE3(const KeyFramePtr& kf, const std::vector<KeyFramePtr>& cands);
   bool verifyCandidate(const KeyFramePtr& kf, const KeyFramePtr& cand, const std::vector<uint8_t>& use1,
                        std::mt19937& rng);
@@ -100,7 +102,9 @@ class LoopClosing {
   bool withinDriftBound(const KeyFrame& kf, const KeyFrame& cand, const Pose& T_cw, double& corr_m,
                         double& corr_deg) const;
 
-  void correctLoop(const KeyFramePtr& kf);   // takes update_mutex
+  // Correction: takes update_mutex (never while pausing LocalMapping); its steps 1-5 below run
+  // with it held.
+  void correctLoop(const KeyFramePtr& kf);
   // 1. Moves the current keyframe's neighbourhood (and the points it sees) rigidly with it.
   Neighbourhood moveNeighbourhood(const KeyFramePtr& kf);
   // 2. Fuses the verified matches (the current keyframe's points become the loop side's), then
@@ -126,10 +130,12 @@ class LoopClosing {
 
   // Pauses LocalMapping and waits until it is paused; caller must NOT hold update_mutex.
   void pauseMapping();
-  void startGlobalBA(long loop_kf_id);   // Sequential: runs it to the end; no lock held
+  // Global BA: started with no lock held (Sequential: runs it to the end); runGlobalBA takes
+  // update_mutex for the copy and the write-back, inside which the three helpers below run.
+  void startGlobalBA(long loop_kf_id);
   void stopGlobalBA();
-  void runGlobalBA(long loop_kf_id);     // takes update_mutex for the copy and the write-back
-  optimization::BaProblem globalProblem() const;   // caller holds update_mutex (so below)
+  void runGlobalBA(long loop_kf_id);
+  optimization::BaProblem globalProblem() const;
   // Returns the correction T_wc_new * T_cw_old per keyframe written.
   std::unordered_map<long, Pose> writeBackKeyFrames(const optimization::BaProblem& problem);
   void writeBackPoints(const optimization::BaProblem& problem, const std::unordered_map<long, Pose>& corr);
