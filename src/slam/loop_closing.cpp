@@ -495,7 +495,7 @@ void LoopClosing::correctLoop(const KeyFramePtr& kf) {
     const Neighbourhood n = moveNeighbourhood(kf);
     fuseCurrentMatches(kf);
     fuseLoopPoints(n.kfs);
-    const std::vector<std::pair<long, long>> new_links = linkLoop(kf, loop_kf, n);
+    const Links new_links = linkLoop(kf, loop_kf, n);
     const auto kfs = map_.keyframes();
     std::map<long, Pose> T_wc_start;
     for (const auto& k : kfs) T_wc_start[k->id] = k->Twc();
@@ -565,12 +565,12 @@ void LoopClosing::fuseLoopPoints(const std::vector<KeyFramePtr>& neighbourhood) 
     if (!c->bad) matcher::fuse(map_, c, loop_points, kLoopFuseWindow);
 }
 
-std::vector<std::pair<long, long>> LoopClosing::linkLoop(const KeyFramePtr& kf, const KeyFramePtr& loop_kf,
-                                                         const Neighbourhood& n) {
+LoopClosing::Links LoopClosing::linkLoop(const KeyFramePtr& kf, const KeyFramePtr& loop_kf,
+                                         const Neighbourhood& n) {
   std::map<long, std::set<long>> prev_neighbours;
   for (const auto& c : n.kfs)
     for (const auto& nb : c->ordered_connections) prev_neighbours[c->id].insert(nb->id);
-  std::vector<std::pair<long, long>> new_links;
+  Links new_links;
   for (const auto& c : n.kfs) {
     if (c->bad) continue;
     c->updateConnections();
@@ -587,8 +587,7 @@ std::vector<std::pair<long, long>> LoopClosing::linkLoop(const KeyFramePtr& kf, 
 
 std::vector<optimization::PoseGraphEdge> LoopClosing::essentialGraphEdges(
     const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const std::vector<KeyFramePtr>& kfs,
-    const std::map<long, Pose>& T_wc, const std::map<long, Pose>& T_wc_meas,
-    const std::vector<std::pair<long, long>>& new_links) const {
+    const std::map<long, Pose>& T_wc, const std::map<long, Pose>& T_wc_meas, const Links& new_links) const {
   std::vector<optimization::PoseGraphEdge> edges;
   std::set<std::pair<long, long>> have;
   auto add_edge = [&](long a, long b, const std::map<long, Pose>& poses) {
@@ -618,8 +617,7 @@ std::vector<optimization::PoseGraphEdge> LoopClosing::essentialGraphEdges(
 std::map<long, Pose> LoopClosing::optimizeEssentialGraph(const KeyFramePtr& kf, const KeyFramePtr& loop_kf,
                                                          const std::vector<KeyFramePtr>& kfs,
                                                          const std::map<long, Pose>& T_wc_start,
-                                                         const Neighbourhood& n,
-                                                         const std::vector<std::pair<long, long>>& new_links) {
+                                                         const Neighbourhood& n, const Links& new_links) {
   // Nodes start at the corrected poses; edges are measured on the uncorrected ones (the
   // odometry before the loop), new links on the corrected ones.
   std::map<long, Pose> T_wc = T_wc_start, T_wc_meas;

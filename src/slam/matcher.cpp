@@ -73,8 +73,7 @@ bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, 
   const Eigen::Vector3d pc = F.T_cw * mp->Xw;
   if (!(pc.z() > 0)) return false;
   const Eigen::Vector2d uv = F.cam.project(pc);
-  if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-    return false;
+  if (F.geom.outside(uv)) return false;
   const Eigen::Vector3d PO = mp->Xw - F.cameraCenter();
   const double d = PO.norm();
   if (d < kMinDistFactor * mp->min_dist || d > kMaxDistFactor * mp->max_dist) return false;
@@ -105,8 +104,7 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
     const Eigen::Vector3d pc = F.T_cw * mp->Xw;
     if (!(pc.z() > 0)) continue;
     const Eigen::Vector2d uv = F.cam.project(pc);
-    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-      continue;
+    if (F.geom.outside(uv)) continue;
     const int oct = last.kps[i].octave;
     const double radius = th * pyr.scale[oct];
     std::vector<size_t> cand;
@@ -308,8 +306,7 @@ int fuse(Map& map, const KeyFramePtr& kf, const std::vector<MapPointPtr>& points
     const Eigen::Vector3d pc = F.T_cw * mp->Xw;
     if (!(pc.z() > 0)) continue;
     const Eigen::Vector2d uv = F.cam.project(pc);
-    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-      continue;
+    if (F.geom.outside(uv)) continue;
     const double ur = uv.x() - F.cam.bf / pc.z();
     const Eigen::Vector3d PO = mp->Xw - Ow;
     const double d = PO.norm();

@@ -34,6 +34,9 @@ struct FrameGeometry {
   double min_x = 0, max_x = 640, min_y = 0, max_y = 480;
   double inv_cell_w = 0, inv_cell_h = 0;
   static FrameGeometry make(const CameraModel& cam);
+  bool outside(const Eigen::Vector2d& uv) const {
+    return uv.x() < min_x || uv.x() > max_x || uv.y() < min_y || uv.y() > max_y;
+  }
 };
 
 class Frame {
