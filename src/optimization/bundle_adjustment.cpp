@@ -3,6 +3,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/optimization/reprojection.h"
 #include "yolo_slam/optimization/se3.h"
+#include "solver_options.h"
 
 #include <ceres/ceres.h>
 
@@ -103,7 +104,7 @@ struct Check {
 Check check(const Intrinsics& K, const Workspace& w, const BaObservation& o, size_t i) {
   Eigen::Map<const Eigen::Vector3d> X(w.points[w.obs_pt[i]].data());
   ReprojectionCheck c = checkReprojection(K, w.poses[w.obs_kf[i]].data(), X, o.uv, o.u_right, o.inv_sigma2);
-  return {c.chi2, o.u_right >= 0 ? kChi2Stereo : kChi2Mono, c.depth};
+  return {c.chi2, chi2Threshold(o.u_right), c.depth};
 }
 
 double robustCost(const Intrinsics& K, const Workspace& w, const BaProblem& p) {
@@ -115,6 +116,22 @@ double robustCost(const Intrinsics& K, const Workspace& w, const BaProblem& p) {
   }
   return cost;
 }
+
+// Points first in the elimination order: the Schur complement leaves a small camera system.
+std::shared_ptr<ceres::ParameterBlockOrdering> schurOrdering(Workspace& w, const std::vector<bool>& pose_added,
+                                                             const std::vector<bool>& point_added) {
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (size_t j = 0; j < w.points.size(); ++j) {
+    if (point_added[j]) ordering->AddElementToGroup(w.points[j].data(), 0);
+  }
+  for (size_t k = 0; k < w.poses.size(); ++k) {
+    if (pose_added[k]) ordering->AddElementToGroup(w.poses[k].data(), 1);
+  }
+  return ordering;
+}
+
+// Above this many free poses the sparse Schur solver beats the dense one (this project's choice).
+constexpr int kMaxDensePoses = 60;
 
 // One Ceres solve over the observations with include[i] set. Returns the iterations used.
 int solveStage(const Intrinsics& K, Workspace& w, const BaProblem& p,
@@ -143,36 +160,19 @@ int solveStage(const Intrinsics& K, Workspace& w, const BaProblem& p,
       }
     }
     point_added[w.obs_pt[i]] = true;
-    if (o.u_right >= 0) {
-      problem.AddResidualBlock(new BaCost<3>(K, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right), o.inv_sigma2),
-                               robust ? &loss_stereo : nullptr, pose, point);
-    } else {
-      problem.AddResidualBlock(new BaCost<2>(K, o.uv, o.inv_sigma2),
-                               robust ? &loss_mono : nullptr, pose, point);
-    }
+    ceres::LossFunction* loss = o.u_right >= 0 ? &loss_stereo : &loss_mono;
+    problem.AddResidualBlock(newBaCost(K, o.uv, o.u_right, o.inv_sigma2), robust ? loss : nullptr, pose, point);
     ++n_residuals;
   }
   if (n_residuals == 0 || max_iterations <= 0) return 0;
 
-  ceres::Solver::Options sopts;
-  // Points first in the elimination order: the Schur complement leaves a small camera system.
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (size_t j = 0; j < w.points.size(); ++j) {
-    if (point_added[j]) ordering->AddElementToGroup(w.points[j].data(), 0);
-  }
-  for (size_t k = 0; k < w.poses.size(); ++k) {
-    if (pose_added[k]) ordering->AddElementToGroup(w.poses[k].data(), 1);
-  }
-  sopts.linear_solver_ordering = ordering;
   // Dense reduced camera matrix is fastest for local windows; large problems go sparse.
-  sopts.linear_solver_type =
-      n_free_poses > 60 && ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)
+  ceres::Solver::Options sopts = solverOptions(
+      n_free_poses > kMaxDensePoses && ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)
           ? ceres::SPARSE_SCHUR
-          : ceres::DENSE_SCHUR;
-  sopts.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  sopts.max_num_iterations = max_iterations;
-  sopts.num_threads = 1;
-  sopts.logging_type = ceres::SILENT;
+          : ceres::DENSE_SCHUR,
+      max_iterations);
+  sopts.linear_solver_ordering = schurOrdering(w, pose_added, point_added);
   StopCallback callback(stop, stopped);
   if (stop) sopts.callbacks.push_back(&callback);
 
@@ -249,17 +249,23 @@ BaResult runBa(const CameraModel& cam, BaProblem& p, int first_iterations, int s
   return res;
 }
 
+// Iterations of the two stages of local BA (ORB-SLAM2 LocalBundleAdjustment: 5 robust, then 10
+// without the kernel and the outliers).
+constexpr int kLocalRobustIterations = 5;
+constexpr int kLocalRefineIterations = 10;
+
 }  // namespace
 
 BaResult localBundleAdjustment(const CameraModel& cam, BaProblem& problem, const bool* stop_flag) {
   StopFn stop;
   if (stop_flag) stop = [stop_flag] { return __atomic_load_n(stop_flag, __ATOMIC_ACQUIRE); };
-  return runBa(cam, problem, 5, 10, stop);
+  return runBa(cam, problem, kLocalRobustIterations, kLocalRefineIterations, stop);
 }
 
 BaResult localBundleAdjustment(const CameraModel& cam, BaProblem& problem,
                                const std::atomic<bool>& stop_flag) {
-  return runBa(cam, problem, 5, 10, [&stop_flag] { return stop_flag.load(); });
+  return runBa(cam, problem, kLocalRobustIterations, kLocalRefineIterations,
+               [&stop_flag] { return stop_flag.load(); });
 }
 
 BaResult globalBundleAdjustment(const CameraModel& cam, BaProblem& problem, int iterations) {

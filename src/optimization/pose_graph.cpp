@@ -2,6 +2,8 @@
 
 #include "yolo_slam/common/error.h"
 
+#include "solver_options.h"
+
 #include <ceres/ceres.h>
 
 #include <array>
@@ -46,15 +48,13 @@ struct RelativePoseError {
   double sqrt_w;
 };
 
-}  // namespace
+struct Node {
+  std::array<double, 4> q;
+  std::array<double, 3> t;
+};
 
-PoseGraphResult optimizePoseGraph(std::map<long, Pose>& T_wc, const std::vector<PoseGraphEdge>& edges,
-                                  const std::set<long>& fixed, int iterations) {
-  PoseGraphResult res;
-  struct Node {
-    std::array<double, 4> q;
-    std::array<double, 3> t;
-  };
+// The nodes the edges touch, at their T_wc; throws on a bad edge or node.
+std::unordered_map<long, Node> graphNodes(const std::map<long, Pose>& T_wc, const std::vector<PoseGraphEdge>& edges) {
   std::unordered_map<long, Node> nodes;
   for (size_t i = 0; i < edges.size(); ++i) {
     const PoseGraphEdge& e = edges[i];
@@ -79,6 +79,15 @@ PoseGraphResult optimizePoseGraph(std::map<long, Pose>& T_wc, const std::vector<
       nodes.emplace(id, n);
     }
   }
+  return nodes;
+}
+
+}  // namespace
+
+PoseGraphResult optimizePoseGraph(std::map<long, Pose>& T_wc, const std::vector<PoseGraphEdge>& edges,
+                                  const std::set<long>& fixed, int iterations) {
+  PoseGraphResult res;
+  std::unordered_map<long, Node> nodes = graphNodes(T_wc, edges);
   if (edges.empty() || iterations <= 0) return res;
 
   ceres::Problem::Options popts;
@@ -101,14 +110,10 @@ PoseGraphResult optimizePoseGraph(std::map<long, Pose>& T_wc, const std::vector<
     problem.AddResidualBlock(cost, nullptr, a.q.data(), a.t.data(), b.q.data(), b.t.data());
   }
 
-  ceres::Solver::Options sopts;
-  sopts.linear_solver_type = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)
-                                 ? ceres::SPARSE_NORMAL_CHOLESKY
-                                 : ceres::DENSE_QR;
-  sopts.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  sopts.max_num_iterations = iterations;
-  sopts.num_threads = 1;
-  sopts.logging_type = ceres::SILENT;
+  const ceres::Solver::Options sopts = solverOptions(
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SPARSE_NORMAL_CHOLESKY
+                                                                          : ceres::DENSE_QR,
+      iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(sopts, &problem, &summary);
   res.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);

@@ -2,6 +2,7 @@
 
 #include "yolo_slam/optimization/reprojection.h"
 #include "yolo_slam/optimization/se3.h"
+#include "solver_options.h"
 
 #include <ceres/ceres.h>
 
@@ -38,6 +39,34 @@ bool usable(const PoseObservation& o) {
          std::isfinite(o.inv_sigma2) && o.inv_sigma2 > 0;
 }
 
+// ORB-SLAM2 PoseOptimization: observations needed at all, Levenberg-Marquardt iterations per
+// round, and the inliers below which the rounds stop.
+constexpr int kMinObservations = 3;
+constexpr int kIterationsPerRound = 10;
+constexpr int kMinActive = 10;
+
+// Re-classifies every observation at the current pose (unusable ones stay outliers); returns
+// the outliers, n_active the inliers.
+int classify(const Intrinsics& K, const double* pose, const std::vector<PoseObservation>& obs,
+             std::vector<bool>& is_outlier, bool* active, int* n_active) {
+  int n_bad = 0;
+  *n_active = 0;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (!usable(obs[i])) {
+      ++n_bad;
+      continue;
+    }
+    const PoseObservation& o = obs[i];
+    ReprojectionCheck c = checkReprojection(K, pose, o.Xw, o.uv, o.u_right, o.inv_sigma2);
+    const bool bad = !(c.chi2 <= chi2Threshold(o.u_right)) || !(c.depth > 0);
+    is_outlier[i] = bad;
+    active[i] = !bad;
+    n_bad += bad ? 1 : 0;
+    *n_active += bad ? 0 : 1;
+  }
+  return n_bad;
+}
+
 }  // namespace
 
 int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObservation>& obs,
@@ -52,7 +81,7 @@ int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObser
       is_outlier[i] = true;
     }
   }
-  if (n_usable < 3 || rounds < 1 || !T_cw.matrix().allFinite()) return 0;
+  if (n_usable < kMinObservations || rounds < 1 || !T_cw.matrix().allFinite()) return 0;
 
   const Intrinsics K = Intrinsics::from(cam);
   double pose[kPoseParams];
@@ -77,47 +106,19 @@ int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObser
     active[i] = !is_outlier[i];
     if (is_outlier[i]) continue;
     const PoseObservation& o = obs[i];
-    if (o.u_right >= 0) {
-      costs.emplace_back(new PoseOnlyCost<3>(K, o.Xw, Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right),
-                                             o.inv_sigma2, &active[i]));
-      problem.AddResidualBlock(costs.back().get(), &loss_stereo, pose);
-    } else {
-      costs.emplace_back(new PoseOnlyCost<2>(K, o.Xw, o.uv, o.inv_sigma2, &active[i]));
-      problem.AddResidualBlock(costs.back().get(), &loss_mono, pose);
-    }
+    costs.emplace_back(newPoseOnlyCost(K, o.Xw, o.uv, o.u_right, o.inv_sigma2, &active[i]));
+    problem.AddResidualBlock(costs.back().get(), o.u_right >= 0 ? &loss_stereo : &loss_mono, pose);
   }
 
-  ceres::Solver::Options sopts;
-  sopts.linear_solver_type = ceres::DENSE_QR;
-  sopts.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  sopts.max_num_iterations = 10;
-  sopts.num_threads = 1;
-  sopts.logging_type = ceres::SILENT;
-  sopts.minimizer_progress_to_stdout = false;
-
+  const ceres::Solver::Options sopts = solverOptions(ceres::DENSE_QR, kIterationsPerRound);
   int n_bad = 0;
   for (int round = 0; round < rounds; ++round) {
     ceres::Solver::Summary summary;
     ceres::Solve(sopts, &problem, &summary);
-
-    n_bad = 0;
     int n_active = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (!usable(obs[i])) {
-        ++n_bad;
-        continue;
-      }
-      const PoseObservation& o = obs[i];
-      ReprojectionCheck c = checkReprojection(K, pose, o.Xw, o.uv, o.u_right, o.inv_sigma2);
-      const double th = o.u_right >= 0 ? kChi2Stereo : kChi2Mono;
-      const bool bad = !(c.chi2 <= th) || !(c.depth > 0);
-      is_outlier[i] = bad;
-      active[i] = !bad;
-      n_bad += bad ? 1 : 0;
-      n_active += bad ? 0 : 1;
-    }
+    n_bad = classify(K, pose, obs, is_outlier, active.get(), &n_active);
     if (round == rounds - 2) robust = false;
-    if (n_active < 10) break;
+    if (n_active < kMinActive) break;
   }
 
   Pose result = paramsToPose(pose);

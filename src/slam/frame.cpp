@@ -1,5 +1,7 @@
 #include "yolo_slam/slam/frame.h"
 
+#include "yolo_slam/vocabulary/vocabulary.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -140,6 +142,11 @@ std::vector<std::pair<float, int>> Frame::staticByDepth() const {
     if (depth[i] > 0 && !dynamic[i]) out.emplace_back(depth[i], i);
   std::sort(out.begin(), out.end());
   return out;
+}
+
+void computeBow(const vocabulary::Vocabulary* voc, Frame& F) {
+  if (!voc || !F.bow.empty() || F.N == 0) return;
+  voc->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
 }
 
 }  // namespace slam

@@ -26,10 +26,7 @@ int KeyFrame::trackedMapPoints(int min_obs) const {
       ++n;
       continue;
     }
-    // ORB-SLAM2 counts an observation with depth (stereo) twice.
-    int obs = 0;
-    for (const auto& o : p->observations) obs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
-    if (obs >= min_obs) ++n;
+    if (p->weightedObservations() >= min_obs) ++n;
   }
   return n;
 }
@@ -74,14 +71,13 @@ void KeyFrame::updateConnections() {
   if (counter.empty()) return;
   int max_w = 0;
   KeyFramePtr best;
-  const int th = 15;
   std::map<KeyFramePtr, int, ById> kept;
   for (const auto& c : counter) {
     if (c.second > max_w) {
       max_w = c.second;
       best = c.first;
     }
-    if (c.second >= th) {
+    if (c.second >= kCovisibilityMinWeight) {
       kept[c.first] = c.second;
       c.first->addConnection(self(), c.second);
     }
@@ -104,27 +100,19 @@ std::vector<KeyFramePtr> KeyFrame::bestCovisibles(size_t n) const {
   return std::vector<KeyFramePtr>(ordered_connections.begin(), ordered_connections.begin() + n);
 }
 
-std::vector<KeyFramePtr> KeyFrame::covisiblesByWeight(int w) const {
-  std::vector<KeyFramePtr> out;
-  for (size_t i = 0; i < ordered_connections.size() && ordered_weights[i] >= w; ++i)
-    out.push_back(ordered_connections[i]);
-  return out;
-}
-
 int KeyFrame::weight(const KeyFramePtr& kf) const {
   auto it = connections.find(kf);
   return it == connections.end() ? 0 : it->second;
 }
 
-double KeyFrame::sceneMedianDepth() const {
-  std::vector<double> z;
-  for (const auto& p : f.points) {
-    if (!p || p->bad) continue;
-    z.push_back((f.T_cw * p->Xw).z());
+KeyFramePtr liveAncestor(KeyFramePtr kf, Pose* T_kr) {
+  Pose T = Pose::Identity();
+  while (kf && kf->bad) {
+    T = T * kf->T_cp;
+    kf = kf->parent;
   }
-  if (z.empty()) return 1.0;
-  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-  return z[z.size() / 2];
+  if (T_kr) *T_kr = T;
+  return kf;
 }
 
 }  // namespace slam

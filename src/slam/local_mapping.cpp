@@ -7,7 +7,7 @@
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
-#include "yolo_slam/vocabulary/vocabulary.h"
+#include "yolo_slam/slam/observation.h"
 
 #include <Eigen/SVD>
 
@@ -61,38 +61,29 @@ size_t LocalMapping::queued() const {
   return queue_.size();
 }
 
-void LocalMapping::pause() {
-  pause_requested_.store(true);
+void LocalMapping::requestPause(std::atomic<bool>& flag) {
+  flag.store(true);
   abort_ba_.store(true);
   cv_.notify_all();
 }
+
+void LocalMapping::releasePause(std::atomic<bool>& flag) {
+  {
+    std::lock_guard<std::mutex> lk(queue_mutex_);
+    flag.store(false);
+  }
+  cv_.notify_all();
+}
+
+void LocalMapping::pause() { requestPause(pause_requested_); }
+void LocalMapping::resume() { releasePause(pause_requested_); }
+void LocalMapping::pauseForLoop() { requestPause(loop_pause_); }
+void LocalMapping::resumeFromLoop() { releasePause(loop_pause_); }
 
 void LocalMapping::waitUntilPaused() {
   std::unique_lock<std::mutex> lk(queue_mutex_);
   if (!thread_.joinable()) return;
   cv_.wait(lk, [this] { return paused_ack_ || stop_ || !pauseWanted(); });
-}
-
-void LocalMapping::pauseForLoop() {
-  loop_pause_.store(true);
-  abort_ba_.store(true);
-  cv_.notify_all();
-}
-
-void LocalMapping::resumeFromLoop() {
-  {
-    std::lock_guard<std::mutex> lk(queue_mutex_);
-    loop_pause_.store(false);
-  }
-  cv_.notify_all();
-}
-
-void LocalMapping::resume() {
-  {
-    std::lock_guard<std::mutex> lk(queue_mutex_);
-    pause_requested_.store(false);
-  }
-  cv_.notify_all();
 }
 
 void LocalMapping::waitIdle() {
@@ -109,18 +100,9 @@ void LocalMapping::clear() {
   accept_.store(true);
 }
 
-std::vector<double> LocalMapping::timings() const {
-  std::lock_guard<std::mutex> lk(queue_mutex_);
-  return timings_;
-}
-size_t LocalMapping::processedKeyFrames() const {
-  std::lock_guard<std::mutex> lk(queue_mutex_);
-  return processed_;
-}
-size_t LocalMapping::culledKeyFrames() const {
-  std::lock_guard<std::mutex> lk(queue_mutex_);
-  return culled_;
-}
+std::vector<double> LocalMapping::timings() const { return lockedCopy(queue_mutex_, timings_); }
+size_t LocalMapping::processedKeyFrames() const { return lockedCopy(queue_mutex_, processed_); }
+size_t LocalMapping::culledKeyFrames() const { return lockedCopy(queue_mutex_, culled_); }
 
 void LocalMapping::run() {
   std::unique_lock<std::mutex> lk(queue_mutex_);
@@ -166,6 +148,7 @@ void LocalMapping::processFront(std::unique_lock<std::mutex>& lk) {
 }
 
 namespace {
+
 bool queueEmpty(std::mutex& m, const std::deque<KeyFramePtr>& q) {
   std::lock_guard<std::mutex> lk(m);
   return q.empty();
@@ -196,8 +179,7 @@ void LocalMapping::processOne(const KeyFramePtr& kf) {
 
 void LocalMapping::processNewKeyFrame() {
   KeyFrame& kf = *current_;
-  if (voc_ && kf.f.bow.empty() && kf.f.N > 0)
-    voc_->transform(kf.f.descriptors, kf.f.bow.bow, kf.f.bow.features, kBowLevelsUp);
+  computeBow(voc_.get(), kf.f);
   for (size_t i = 0; i < kf.f.points.size(); ++i) {
     MapPointPtr mp = kf.f.points[i];
     if (!mp) continue;
@@ -221,20 +203,26 @@ void LocalMapping::processNewKeyFrame() {
 }
 
 void LocalMapping::mapPointCulling() {
+  // ORB-SLAM2 MapPointCulling (stereo/RGB-D): a new point goes if found in less than this share
+  // of the frames that should see it, or if kCullAfterKeyFrames keyframes after its creation it
+  // has at most kCullMaxObservations (weighted) observations; after kKeepAfterKeyFrames it
+  // has proven itself.
+  constexpr double kMinFoundRatio = 0.25;
+  constexpr long kCullAfterKeyFrames = 2;
+  constexpr int kCullMaxObservations = 3;
+  constexpr long kKeepAfterKeyFrames = 3;
   const long cur = current_->id;
   for (auto it = recent_points_.begin(); it != recent_points_.end();) {
     const MapPointPtr& mp = *it;
-    int nobs = 0;
-    for (const auto& o : mp->observations) nobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
     if (mp->bad) {
       it = recent_points_.erase(it);
-    } else if (mp->foundRatio() < 0.25) {
+    } else if (mp->foundRatio() < kMinFoundRatio) {
       map_.eraseMapPoint(mp);
       it = recent_points_.erase(it);
-    } else if (cur - mp->first_kf_id >= 2 && nobs <= 3) {
+    } else if (cur - mp->first_kf_id >= kCullAfterKeyFrames && mp->weightedObservations() <= kCullMaxObservations) {
       map_.eraseMapPoint(mp);
       it = recent_points_.erase(it);
-    } else if (cur - mp->first_kf_id >= 3) {
+    } else if (cur - mp->first_kf_id >= kKeepAfterKeyFrames) {
       it = recent_points_.erase(it);
     } else {
       ++it;
@@ -261,68 +249,102 @@ bool triangulate(const Eigen::Vector3d& xn1, const Eigen::Vector3d& xn2, const P
 
 }  // namespace
 
+namespace {
+
+// ORB-SLAM2 CreateNewMapPoints: distance ratio against octave ratio tolerance (x scale factor),
+// rays more parallel than this cosine are not triangulated without depth, chi2 bounds of the
+// reprojection (2 dof 95%, and ORB-SLAM2's 7.8 for 3 dof).
+constexpr double kScaleConsistency = 1.5;
+constexpr double kMaxParallaxCos = 0.9998;
+constexpr double kTriangulationChi2Mono = 5.991;
+constexpr double kTriangulationChi2Stereo = 7.8;
+
+// One keyframe of a triangulation pair.
+struct View {
+  const KeyFrame& kf;
+  Pose T;                 // T_cw
+  Eigen::Vector3d O;      // camera centre
+  Eigen::Matrix3d R_wc;
+};
+
+View viewOf(const KeyFrame& kf) {
+  const Pose T = kf.Tcw();
+  return {kf, T, kf.center(), T.linear().transpose()};
+}
+
+// A new point's reprojection in a keyframe is within the chi2 bound of its octave.
+bool reprojectionOk(const CameraModel& cam, const ScalePyramid& pyr, const Eigen::Vector3d& pc,
+                    const cv::KeyPoint& kp, double ur, bool stereo) {
+  const Eigen::Vector2d uv = cam.project(pc);
+  const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
+  const double s2 = pyr.sigma2[kp.octave];
+  if (!stereo) return ex * ex + ey * ey <= kTriangulationChi2Mono * s2;
+  const double er = uv.x() - cam.bf / pc.z() - ur;
+  return ex * ex + ey * ey + er * er <= kTriangulationChi2Stereo * s2;
+}
+
+// The point of the match (keypoint i1 of v1, i2 of v2): triangulated when the rays' parallax
+// beats the depth's, else back-projected from the better depth; false if it fails the depth,
+// reprojection or scale-consistency checks (ORB-SLAM2 CreateNewMapPoints).
+bool triangulateMatch(const CameraModel& cam, const View& v1, const View& v2, size_t i1, size_t i2,
+                      const Eigen::Matrix3d& Kinv, Eigen::Vector3d& X) {
+  const Frame& f1 = v1.kf.f;
+  const Frame& f2 = v2.kf.f;
+  const auto& pyr = *f1.pyramid;
+  const cv::KeyPoint& k1 = f1.kps[i1];
+  const cv::KeyPoint& k2 = f2.kps[i2];
+  const double ur1 = f1.right_u[i1], ur2 = f2.right_u[i2];
+  const bool stereo1 = ur1 >= 0, stereo2 = ur2 >= 0;
+  const Eigen::Vector3d xn1 = Kinv * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
+  const Eigen::Vector3d xn2 = Kinv * Eigen::Vector3d(k2.pt.x, k2.pt.y, 1.0);
+  const Eigen::Vector3d ray1 = v1.R_wc * xn1, ray2 = v2.R_wc * xn2;
+  const double cos_rays = ray1.dot(ray2) / (ray1.norm() * ray2.norm());
+  const double b = cam.baseline();
+  const double cos_st1 = stereo1 ? std::cos(2 * std::atan2(b / 2, f1.depth[i1])) : 2.0;
+  const double cos_st2 = stereo2 ? std::cos(2 * std::atan2(b / 2, f2.depth[i2])) : 2.0;
+  const double cos_st = std::min(cos_st1, cos_st2);
+  if (cos_rays < cos_st && cos_rays > 0 && (stereo1 || stereo2 || cos_rays < kMaxParallaxCos)) {
+    if (!triangulate(xn1, xn2, v1.T, v2.T, X)) return false;
+  } else if (stereo1 && cos_st1 < cos_st2) {
+    if (!f1.unprojectWorld(i1, X)) return false;
+  } else if (stereo2 && cos_st2 < cos_st1) {
+    if (!f2.unprojectWorld(i2, X)) return false;
+  } else {
+    return false;
+  }
+  const Eigen::Vector3d p1 = v1.T * X, p2 = v2.T * X;
+  if (p1.z() <= 0 || p2.z() <= 0) return false;
+  if (!reprojectionOk(cam, pyr, p1, k1, ur1, stereo1) || !reprojectionOk(cam, pyr, p2, k2, ur2, stereo2))
+    return false;
+  const double d1 = (X - v1.O).norm(), d2 = (X - v2.O).norm();
+  if (d1 == 0 || d2 == 0) return false;
+  const double ratio_factor = kScaleConsistency * pyr.scale_factor;
+  const double ratio_dist = d2 / d1;
+  const double ratio_oct = pyr.scale[k1.octave] / pyr.scale[k2.octave];
+  return !(ratio_dist * ratio_factor < ratio_oct || ratio_dist > ratio_oct * ratio_factor);
+}
+
+}  // namespace
+
 void LocalMapping::createNewMapPoints() {
   const KeyFramePtr& kf1 = current_;
-  const auto& pyr = *kf1->f.pyramid;
-  const double ratio_factor = 1.5 * pyr.scale_factor;
-  std::vector<KeyFramePtr> neigh = kf1->bestCovisibles(opt_.triangulation_neighbours);
-  const Pose T1 = kf1->Tcw();
-  const Eigen::Vector3d O1 = kf1->center();
+  const std::vector<KeyFramePtr> neigh = kf1->bestCovisibles(opt_.triangulation_neighbours);
+  const View v1 = viewOf(*kf1);
   const Eigen::Matrix3d K = (Eigen::Matrix3d() << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1).finished();
   const Eigen::Matrix3d Kinv = K.inverse();
   for (const KeyFramePtr& kf2 : neigh) {
     if (kf2->bad) continue;
     if (!queueEmpty(queue_mutex_, queue_) && kf2 != neigh.front()) break;
-    const Eigen::Vector3d O2 = kf2->center();
-    if ((O2 - O1).norm() < cam_.baseline()) continue;
-    const Pose T2 = kf2->Tcw();
-    const Pose T21 = T2 * T1.inverse();
+    const View v2 = viewOf(*kf2);
+    if ((v2.O - v1.O).norm() < cam_.baseline()) continue;
+    const Pose T21 = v2.T * v1.T.inverse();
     const Eigen::Matrix3d F21 = Kinv.transpose() * skew(T21.translation()) * T21.linear() * Kinv;
-    auto matches = matcher::searchForTriangulation(*kf1, *kf2, F21);
-    const Eigen::Matrix3d R1wc = T1.linear().transpose(), R2wc = T2.linear().transpose();
-    for (const auto& m : matches) {
-      const size_t i1 = m.first, i2 = m.second;
-      const cv::KeyPoint& k1 = kf1->f.kps[i1];
-      const cv::KeyPoint& k2 = kf2->f.kps[i2];
-      const double ur1 = kf1->f.right_u[i1], ur2 = kf2->f.right_u[i2];
-      const bool stereo1 = ur1 >= 0, stereo2 = ur2 >= 0;
-      const Eigen::Vector3d xn1 = Kinv * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
-      const Eigen::Vector3d xn2 = Kinv * Eigen::Vector3d(k2.pt.x, k2.pt.y, 1.0);
-      const Eigen::Vector3d ray1 = R1wc * xn1, ray2 = R2wc * xn2;
-      const double cos_rays = ray1.dot(ray2) / (ray1.norm() * ray2.norm());
-      const double b = cam_.baseline();
-      const double cos_st1 = stereo1 ? std::cos(2 * std::atan2(b / 2, kf1->f.depth[i1])) : 2.0;
-      const double cos_st2 = stereo2 ? std::cos(2 * std::atan2(b / 2, kf2->f.depth[i2])) : 2.0;
-      const double cos_st = std::min(cos_st1, cos_st2);
+    for (const auto& m : matcher::searchForTriangulation(*kf1, *kf2, F21)) {
       Eigen::Vector3d X;
-      if (cos_rays < cos_st && cos_rays > 0 && (stereo1 || stereo2 || cos_rays < 0.9998)) {
-        if (!triangulate(xn1, xn2, T1, T2, X)) continue;
-      } else if (stereo1 && cos_st1 < cos_st2) {
-        if (!kf1->f.unprojectWorld(i1, X)) continue;
-      } else if (stereo2 && cos_st2 < cos_st1) {
-        if (!kf2->f.unprojectWorld(i2, X)) continue;
-      } else {
-        continue;
-      }
-      const Eigen::Vector3d p1 = T1 * X, p2 = T2 * X;
-      if (p1.z() <= 0 || p2.z() <= 0) continue;
-      auto reproj_ok = [&](const Eigen::Vector3d& pc, const cv::KeyPoint& kp, double ur, bool stereo) {
-        const Eigen::Vector2d uv = cam_.project(pc);
-        const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
-        const double s2 = pyr.sigma2[kp.octave];
-        if (!stereo) return ex * ex + ey * ey <= 5.991 * s2;
-        const double er = uv.x() - cam_.bf / pc.z() - ur;
-        return ex * ex + ey * ey + er * er <= 7.8 * s2;
-      };
-      if (!reproj_ok(p1, k1, ur1, stereo1) || !reproj_ok(p2, k2, ur2, stereo2)) continue;
-      const double d1 = (X - O1).norm(), d2 = (X - O2).norm();
-      if (d1 == 0 || d2 == 0) continue;
-      const double ratio_dist = d2 / d1;
-      const double ratio_oct = pyr.scale[k1.octave] / pyr.scale[k2.octave];
-      if (ratio_dist * ratio_factor < ratio_oct || ratio_dist > ratio_oct * ratio_factor) continue;
+      if (!triangulateMatch(cam_, v1, v2, m.first, m.second, Kinv, X)) continue;
       auto mp = std::make_shared<MapPoint>(map_.newPointId(), X, kf1.get(), kf1->frame_id);
-      Map::addObservation(mp, kf1, i1);
-      Map::addObservation(mp, kf2, i2);
+      Map::addObservation(mp, kf1, m.first);
+      Map::addObservation(mp, kf2, m.second);
       mp->computeDistinctiveDescriptor();
       mp->updateNormalAndDepth();
       map_.addMapPoint(mp);
@@ -340,9 +362,11 @@ void LocalMapping::searchInNeighbors() {
     if (kf->bad || !seen.insert(kf->id).second) continue;
     targets.push_back(kf);
   }
+  // ORB-SLAM2 SearchInNeighbors: the best covisibles of each neighbour are targets too.
+  constexpr size_t kFuseSecondNeighbours = 5;
   const size_t n1 = targets.size();
   for (size_t k = 0; k < n1; ++k)
-    for (const auto& kf2 : targets[k]->bestCovisibles(5))
+    for (const auto& kf2 : targets[k]->bestCovisibles(kFuseSecondNeighbours))
       if (!kf2->bad && seen.insert(kf2->id).second) targets.push_back(kf2);
 
   std::vector<MapPointPtr> cur_points = cur->mapPoints();
@@ -362,79 +386,95 @@ void LocalMapping::searchInNeighbors() {
   cur->updateConnections();
 }
 
-void LocalMapping::localBundleAdjustment() {
+namespace {
+
+// The local BA window and the map objects behind its indices.
+struct LocalWindow {
   optimization::BaProblem problem;
-  std::vector<KeyFramePtr> kfs;         // index = problem.keyframes index
-  std::vector<MapPointPtr> points;      // index = problem.points index
+  std::vector<KeyFramePtr> kfs;                    // index = problem.keyframes index
+  std::vector<MapPointPtr> points;                 // index = problem.points index
   std::vector<std::pair<size_t, size_t>> obs_ref;  // (kf index, point index) per observation
+};
+
+// The current keyframe and its covisibles (free), the points they see, and the other keyframes
+// seeing those points (fixed). Caller holds update_mutex.
+LocalWindow localWindow(const KeyFramePtr& current) {
+  LocalWindow w;
+  std::unordered_map<long, size_t> kf_index;
+  auto add_kf = [&](const KeyFramePtr& kf, bool fixed) {
+    kf_index[kf->id] = w.kfs.size();
+    w.kfs.push_back(kf);
+    w.problem.keyframes.push_back({kf->id, kf->Tcw(), fixed || kf->is_origin});
+  };
+  add_kf(current, false);
+  for (const auto& kf : current->ordered_connections)
+    if (!kf->bad && !kf_index.count(kf->id)) add_kf(kf, false);
+  const size_t n_local = w.kfs.size();
+  std::set<long> point_ids;
+  for (size_t k = 0; k < n_local; ++k) {
+    for (const auto& mp : w.kfs[k]->f.points) {
+      if (!mp || mp->bad || mp->dynamic || !point_ids.insert(mp->id).second) continue;
+      w.points.push_back(mp);
+    }
+  }
+  for (const auto& mp : w.points)
+    for (const auto& o : mp->observations)
+      if (!o.first->bad && !kf_index.count(o.first->id)) add_kf(o.first, true);
+  for (size_t p = 0; p < w.points.size(); ++p) {
+    const auto& mp = w.points[p];
+    w.problem.points.push_back({mp->id, mp->Xw});
+    for (const auto& o : mp->observations) {
+      if (o.first->bad) continue;
+      w.problem.observations.push_back(baObservation(o.first->f, o.second, o.first->id, mp->id));
+      w.obs_ref.emplace_back(kf_index[o.first->id], p);
+    }
+  }
+  return w;
+}
+
+// Erases the outlier observations, then writes the free poses and the points. Caller holds
+// update_mutex.
+void writeBackLocalWindow(Map& map, const LocalWindow& w, const optimization::BaResult& result) {
+  for (size_t k = 0; k < w.obs_ref.size() && k < result.outlier_observation.size(); ++k) {
+    if (!result.outlier_observation[k]) continue;
+    const KeyFramePtr& kf = w.kfs[w.obs_ref[k].first];
+    const MapPointPtr& mp = w.points[w.obs_ref[k].second];
+    if (mp->bad || kf->bad) continue;
+    map.eraseObservation(mp, kf);
+  }
+  for (size_t k = 0; k < w.kfs.size(); ++k) {
+    const auto& bk = w.problem.keyframes[k];
+    if (bk.fixed || w.kfs[k]->bad || !bk.T_cw.matrix().allFinite()) continue;
+    w.kfs[k]->f.T_cw = bk.T_cw;
+  }
+  for (size_t p = 0; p < w.points.size(); ++p) {
+    const auto& mp = w.points[p];
+    if (mp->bad || !w.problem.points[p].Xw.allFinite()) continue;
+    mp->Xw = w.problem.points[p].Xw;
+    mp->updateNormalAndDepth();
+  }
+}
+
+}  // namespace
+
+void LocalMapping::localBundleAdjustment() {
+  LocalWindow w;
   {
     std::lock_guard<std::mutex> lk(map_.update_mutex);
     if (current_->bad || map_.numKeyFrames() <= 2) return;
-    std::unordered_map<long, size_t> kf_index;
-    auto add_kf = [&](const KeyFramePtr& kf, bool fixed) {
-      kf_index[kf->id] = kfs.size();
-      kfs.push_back(kf);
-      problem.keyframes.push_back({kf->id, kf->Tcw(), fixed || kf->is_origin});
-    };
-    add_kf(current_, false);
-    for (const auto& kf : current_->ordered_connections)
-      if (!kf->bad && !kf_index.count(kf->id)) add_kf(kf, false);
-    const size_t n_local = kfs.size();
-    std::set<long> point_ids;
-    for (size_t k = 0; k < n_local; ++k) {
-      for (const auto& mp : kfs[k]->f.points) {
-        if (!mp || mp->bad || mp->dynamic || !point_ids.insert(mp->id).second) continue;
-        points.push_back(mp);
-      }
-    }
-    for (const auto& mp : points)
-      for (const auto& o : mp->observations)
-        if (!o.first->bad && !kf_index.count(o.first->id)) add_kf(o.first, true);
-    for (size_t p = 0; p < points.size(); ++p) {
-      const auto& mp = points[p];
-      problem.points.push_back({mp->id, mp->Xw});
-      for (const auto& o : mp->observations) {
-        if (o.first->bad) continue;
-        const Frame& f = o.first->f;
-        const cv::KeyPoint& kp = f.kps[o.second];
-        optimization::BaObservation ob;
-        ob.kf_id = o.first->id;
-        ob.point_id = mp->id;
-        ob.uv = Eigen::Vector2d(kp.pt.x, kp.pt.y);
-        ob.u_right = f.right_u[o.second] >= 0 ? f.right_u[o.second] : -1.0;
-        ob.inv_sigma2 = f.pyramid->inv_sigma2[kp.octave];
-        problem.observations.push_back(ob);
-        obs_ref.emplace_back(kf_index[o.first->id], p);
-      }
-    }
+    w = localWindow(current_);
   }
-  if (problem.observations.empty() || abort_ba_.load()) return;
-  optimization::BaResult result = optimization::localBundleAdjustment(cam_, problem, abort_ba_);
-
+  if (w.problem.observations.empty() || abort_ba_.load()) return;
+  const optimization::BaResult result = optimization::localBundleAdjustment(cam_, w.problem, abort_ba_);
   std::lock_guard<std::mutex> lk(map_.update_mutex);
-  for (size_t k = 0; k < obs_ref.size() && k < result.outlier_observation.size(); ++k) {
-    if (!result.outlier_observation[k]) continue;
-    const KeyFramePtr& kf = kfs[obs_ref[k].first];
-    const MapPointPtr& mp = points[obs_ref[k].second];
-    if (mp->bad || kf->bad) continue;
-    map_.eraseObservation(mp, kf);
-  }
-  for (size_t k = 0; k < kfs.size(); ++k) {
-    const auto& bk = problem.keyframes[k];
-    if (bk.fixed || kfs[k]->bad || !bk.T_cw.matrix().allFinite()) continue;
-    kfs[k]->f.T_cw = bk.T_cw;
-  }
-  for (size_t p = 0; p < points.size(); ++p) {
-    const auto& mp = points[p];
-    if (mp->bad || !problem.points[p].Xw.allFinite()) continue;
-    mp->Xw = problem.points[p].Xw;
-    mp->updateNormalAndDepth();
-  }
+  writeBackLocalWindow(map_, w, result);
 }
 
 void LocalMapping::keyFrameCulling() {
   if (current_->bad) return;
   const double close = cam_.closeDepth();
+  // ORB-SLAM2 KeyFrameCulling: a point is redundant when this many other keyframes see it at
+  // the same or a finer scale.
   const int th_obs = 3;
   std::vector<KeyFramePtr> local = current_->ordered_connections;
   for (const auto& kf : local) {
@@ -446,9 +486,7 @@ void LocalMapping::keyFrameCulling() {
       // RGB-D: only close points count (far ones are not reliable to judge redundancy).
       if (kf->f.depth[i] > close || kf->f.depth[i] < 0) continue;
       ++n_points;
-      int wobs = 0;
-      for (const auto& o : mp->observations) wobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
-      if (wobs <= th_obs) continue;
+      if (mp->weightedObservations() <= th_obs) continue;
       const int level = kf->f.kps[i].octave;
       int n = 0;
       for (const auto& o : mp->observations) {

@@ -40,10 +40,8 @@ void Map::eraseObservation(const MapPointPtr& mp, const KeyFramePtr& kf) {
   mp->observations.erase(it);
   if (mp->ref_kf == kf.get())
     mp->ref_kf = mp->observations.empty() ? nullptr : mp->observations.begin()->first.get();
-  // ORB-SLAM2: observations with depth count twice; a point seen (stereo) once only is dropped.
-  int nobs = 0;
-  for (const auto& o : mp->observations) nobs += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
-  if (nobs <= 2) eraseMapPoint(mp);
+  // ORB-SLAM2: a point seen (with depth) by one keyframe only is dropped.
+  if (mp->weightedObservations() <= 2) eraseMapPoint(mp);
 }
 
 void Map::eraseMapPoint(const MapPointPtr& mp) {
@@ -162,6 +160,13 @@ void Map::clear() {
   if (kfdb_) kfdb_->clear();
 }
 
+namespace {
+// ORB-SLAM2 DetectRelocalizationCandidates / DetectLoopCandidates: a hit is grouped with its best
+// covisibles; groups scoring above this share of the best group's score survive.
+constexpr size_t kGroupCovisibles = 10;
+constexpr double kGroupScoreShare = 0.75;
+}  // namespace
+
 std::vector<KeyFramePtr> covisibilityGroupCandidates(const Map& map,
                                                      const std::vector<std::pair<long, double>>& hits) {
   std::map<long, double> score_of(hits.begin(), hits.end());
@@ -172,7 +177,7 @@ std::vector<KeyFramePtr> covisibilityGroupCandidates(const Map& map,
     if (!kf || kf->bad) continue;
     double acc = h.second, best_score = h.second;
     KeyFramePtr best_kf = kf;
-    for (const auto& nb : kf->bestCovisibles(10)) {
+    for (const auto& nb : kf->bestCovisibles(kGroupCovisibles)) {
       auto it = score_of.find(nb->id);
       if (it == score_of.end() || nb->bad) continue;
       acc += it->second;
@@ -190,7 +195,7 @@ std::vector<KeyFramePtr> covisibilityGroupCandidates(const Map& map,
   std::vector<KeyFramePtr> cands;
   std::set<long> seen;
   for (const auto& g : groups)
-    if (g.first > 0.75 * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
+    if (g.first > kGroupScoreShare * best_acc && seen.insert(g.second->id).second) cands.push_back(g.second);
   return cands;
 }
 

@@ -20,6 +20,12 @@ bool MapPoint::inKeyFrame(const KeyFrame* kf) const {
   return false;
 }
 
+int MapPoint::weightedObservations() const {
+  int n = 0;
+  for (const auto& o : observations) n += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
+  return n;
+}
+
 MapPointPtr MapPoint::resolve(MapPointPtr p) {
   // Replacement chains are short; the bound guards against a (buggy) cycle.
   for (int k = 0; p && p->bad && k < 32; ++k) p = p->replaced;

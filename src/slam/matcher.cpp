@@ -14,6 +14,20 @@ namespace matcher {
 
 namespace {
 
+// ORB-SLAM2 ORBmatcher values.
+constexpr int kNoMatch = 256;               // above any Hamming distance of 256-bit descriptors
+constexpr double kMinRotationShare = 0.1;   // ComputeThreeMaxima: 2nd/3rd bin vs the largest
+constexpr double kMinDistFactor = 0.8;      // isInFrustum: scale-invariance range margins
+constexpr double kMaxDistFactor = 1.2;
+constexpr double kFrontalViewCos = 0.998;   // RadiusByViewingCos: window x 2.5 when this frontal,
+constexpr double kFrontalWindow = 2.5;      // else x 4
+constexpr double kObliqueWindow = 4.0;
+constexpr double kChi2Epipolar = 3.84;      // SearchForTriangulation: chi2(1 dof, 95%)
+constexpr double kMinEpipoleDist2 = 100;    // ... min squared distance to the epipole (x scale)
+constexpr double kChi2FuseMono = 5.99;      // Fuse: chi2(2 dof, 95%) and 3 dof (7.8)
+constexpr double kChi2FuseStereo = 7.8;
+constexpr double kFuseViewCos = 0.5;        // Fuse: at most 60 deg from the mean viewing direction
+
 inline int dist(const cv::Mat& d, int row, const cv::Mat& d2, int row2) {
   return features::hammingDistance(d.ptr<uint8_t>(row), d2.ptr<uint8_t>(row2));
 }
@@ -44,8 +58,8 @@ std::vector<size_t> rotationOutliers(const std::vector<std::vector<size_t>>& his
       m3 = s; i3 = i;
     }
   }
-  if (m2 < 0.1 * m1) i2 = i3 = -1;
-  else if (m3 < 0.1 * m1) i3 = -1;
+  if (m2 < kMinRotationShare * m1) i2 = i3 = -1;
+  else if (m3 < kMinRotationShare * m1) i3 = -1;
   std::vector<size_t> out;
   for (int i = 0; i < static_cast<int>(hist.size()); ++i) {
     if (i == i1 || i == i2 || i == i3) continue;
@@ -59,11 +73,10 @@ bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, 
   const Eigen::Vector3d pc = F.T_cw * mp->Xw;
   if (!(pc.z() > 0)) return false;
   const Eigen::Vector2d uv = F.cam.project(pc);
-  if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-    return false;
+  if (F.geom.outside(uv)) return false;
   const Eigen::Vector3d PO = mp->Xw - F.cameraCenter();
   const double d = PO.norm();
-  if (d < 0.8 * mp->min_dist || d > 1.2 * mp->max_dist) return false;
+  if (d < kMinDistFactor * mp->min_dist || d > kMaxDistFactor * mp->max_dist) return false;
   const double view_cos = PO.dot(mp->normal) / d;
   if (view_cos < min_view_cos) return false;
   out.mp = mp;
@@ -91,8 +104,7 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
     const Eigen::Vector3d pc = F.T_cw * mp->Xw;
     if (!(pc.z() > 0)) continue;
     const Eigen::Vector2d uv = F.cam.project(pc);
-    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-      continue;
+    if (F.geom.outside(uv)) continue;
     const int oct = last.kps[i].octave;
     const double radius = th * pyr.scale[oct];
     std::vector<size_t> cand;
@@ -101,7 +113,7 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
     else cand = F.featuresInArea(uv.x(), uv.y(), radius, oct - 1, oct + 1);
     if (cand.empty() || mp->descriptor.empty()) continue;
     const double ur = uv.x() - F.cam.bf / pc.z();
-    int best = 256;
+    int best = kNoMatch;
     int best_idx = -1;
     for (size_t j : cand) {
       const MapPointPtr& cur = F.points[j];
@@ -133,9 +145,9 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
   for (const Projection& p : proj) {
     const MapPointPtr& mp = p.mp;
     if (!mp || mp->bad || mp->descriptor.empty()) continue;
-    const double r = (p.view_cos > 0.998 ? 2.5 : 4.0) * th * pyr.scale[p.level];
+    const double r = (p.view_cos > kFrontalViewCos ? kFrontalWindow : kObliqueWindow) * th * pyr.scale[p.level];
     std::vector<size_t> cand = F.featuresInArea(p.u, p.v, r, p.level - 1, p.level);
-    int best = 256, best2 = 256, best_level = -1, best_level2 = -1, best_idx = -1;
+    int best = kNoMatch, best2 = kNoMatch, best_level = -1, best_level2 = -1, best_idx = -1;
     for (size_t j : cand) {
       const MapPointPtr& cur = F.points[j];
       if (cur && cur->numObservations() > 0) continue;
@@ -157,7 +169,7 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
       // any static one sits on a moving object, if that keypoint is at the point's depth (a
       // nearer one is a person walking in front of the point: hidden, not moving).
       const double z = p.z;
-      int best_dyn = 256;
+      int best_dyn = kNoMatch;
       for (size_t j : F.featuresInArea(p.u, p.v, r, p.level - 1, p.level, true)) {
         if (z > 0 && F.depth[j] > 0 && std::fabs(F.depth[j] - z) > kDynamicDepthTolerance * z) continue;
         // When the frame-to-frame test ran, only a keypoint it saw move counts: static
@@ -193,7 +205,7 @@ int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
         if (i1 >= kf.f.points.size()) continue;
         const MapPointPtr& mp = kf.f.points[i1];
         if (!mp || mp->bad || mp->dynamic) continue;
-        int best = 256, best2 = 256, best_idx = -1;
+        int best = kNoMatch, best2 = kNoMatch, best_idx = -1;
         for (unsigned i2 : it2->second) {
           if (i2 >= static_cast<unsigned>(F.N) || taken[i2] || F.dynamic[i2]) continue;
           int d = dist(kf.f.descriptors, static_cast<int>(i1), F.descriptors, static_cast<int>(i2));
@@ -240,13 +252,13 @@ std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf
   for (int j = 0; j < kf2.f.N; ++j)
     if (!kf2.f.points[j] && !kf2.f.dynamic[j]) free2.push_back(j);
   std::vector<int> match12(kf1.f.N, -1);
-  std::vector<int> best_for2(kf2.f.N, 256);
+  std::vector<int> best_for2(kf2.f.N, kNoMatch);
   std::vector<int> owner2(kf2.f.N, -1);
   for (int i = 0; i < kf1.f.N; ++i) {
     if (kf1.f.points[i] || kf1.f.dynamic[i]) continue;
     const cv::KeyPoint& k1 = kf1.f.kps[i];
     const bool stereo1 = kf1.f.right_u[i] >= 0;
-    // Epipolar line in image 2: l = F12^T? With x2^T F12 x1 = 0 the line is F12 * x1.
+    // Epipolar line of x1 in image 2 (x2^T F12 x1 = 0): l = F12 x1.
     const Eigen::Vector3d l = F12 * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
     const double ln = l.head<2>().squaredNorm();
     if (ln < 1e-18) continue;
@@ -256,12 +268,12 @@ std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf
       const bool stereo2 = kf2.f.right_u[j] >= 0;
       const double num = l.x() * k2.pt.x + l.y() * k2.pt.y + l.z();
       const double d2 = num * num / ln;
-      if (d2 >= 3.84 * pyr.sigma2[k2.octave]) continue;
+      if (d2 >= kChi2Epipolar * pyr.sigma2[k2.octave]) continue;
       const int d = dist(kf1.f.descriptors, i, kf2.f.descriptors, j);
       if (d >= best) continue;
       if (!stereo1 && !stereo2) {
         const double ex = ep.x() - k2.pt.x, ey = ep.y() - k2.pt.y;
-        if (ex * ex + ey * ey < 100 * pyr.scale[k2.octave]) continue;
+        if (ex * ex + ey * ey < kMinEpipoleDist2 * pyr.scale[k2.octave]) continue;
       }
       best = d;
       best_idx = j;
@@ -294,26 +306,25 @@ int fuse(Map& map, const KeyFramePtr& kf, const std::vector<MapPointPtr>& points
     const Eigen::Vector3d pc = F.T_cw * mp->Xw;
     if (!(pc.z() > 0)) continue;
     const Eigen::Vector2d uv = F.cam.project(pc);
-    if (uv.x() < F.geom.min_x || uv.x() > F.geom.max_x || uv.y() < F.geom.min_y || uv.y() > F.geom.max_y)
-      continue;
+    if (F.geom.outside(uv)) continue;
     const double ur = uv.x() - F.cam.bf / pc.z();
     const Eigen::Vector3d PO = mp->Xw - Ow;
     const double d = PO.norm();
-    if (d < 0.8 * mp->min_dist || d > 1.2 * mp->max_dist) continue;
-    if (PO.dot(mp->normal) < 0.5 * d) continue;
+    if (d < kMinDistFactor * mp->min_dist || d > kMaxDistFactor * mp->max_dist) continue;
+    if (PO.dot(mp->normal) < kFuseViewCos * d) continue;
     const int level = mp->predictScale(d, pyr.n_levels, pyr.log_scale_factor);
     const double radius = th * pyr.scale[level];
-    int best = 256, best_idx = -1;
+    int best = kNoMatch, best_idx = -1;
     for (size_t j : F.featuresInArea(uv.x(), uv.y(), radius)) {
       const cv::KeyPoint& kp = F.kps[j];
       if (kp.octave < level - 1 || kp.octave > level) continue;
       const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
       double e2 = ex * ex + ey * ey;
-      double chi = 5.99;
+      double chi = kChi2FuseMono;
       if (F.right_u[j] >= 0) {
         const double er = ur - F.right_u[j];
         e2 += er * er;
-        chi = 7.8;
+        chi = kChi2FuseStereo;
       }
       if (e2 * pyr.inv_sigma2[kp.octave] > chi) continue;
       const int dd = dist(mp->descriptor, F.descriptors, static_cast<int>(j));

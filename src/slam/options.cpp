@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/option_checks.h"
+#include "yolo_slam/slam/types.h"
 
 namespace yolo_slam {
 namespace slam {
@@ -53,7 +54,8 @@ const OptionTable<LoopClosingOptions>& loopFields() {
       {"LoopClosing.minMatches", &O::min_matches, Range::atLeast(10)},
       {"LoopClosing.maxCorrectionM", &O::max_correction_m, Range::closed(0, 1e6)},
       {"LoopClosing.maxCorrectionDeg", &O::max_correction_deg, Range::closed(0, 180)},
-      {"LoopClosing.covisibilityWeight", &O::covisibility_weight, Range::atLeast(15)},
+      // Weaker pairs have no covisibility edge to take into the essential graph.
+      {"LoopClosing.covisibilityWeight", &O::covisibility_weight, Range::atLeast(kCovisibilityMinWeight)},
       {"LoopClosing.poseGraphIterations", &O::pose_graph_iterations, Range::atLeast(1)},
       {"LoopClosing.globalBA", &O::global_ba},
       {"LoopClosing.globalBAIterations", &O::global_ba_iterations, Range::atLeast(1)},

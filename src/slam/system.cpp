@@ -265,7 +265,7 @@ MapSnapshot System::mapSnapshot() const {
   }
   for (const auto& kf : kfs) {
     for (const auto& c : kf->connections) {
-      if (c.first->id <= kf->id || c.second < 15) continue;
+      if (c.first->id <= kf->id || c.second < kCovisibilityMinWeight) continue;
       auto it = index.find(c.first->id);
       if (it != index.end()) s.covisibility_edges.emplace_back(index[kf->id], it->second);
     }

@@ -6,6 +6,7 @@
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
+#include "yolo_slam/slam/observation.h"
 #include "yolo_slam/vocabulary/keyframe_database.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
@@ -29,7 +30,82 @@ const char* toString(TrackingState s) {
 }
 
 namespace {
+
+// Matching thresholds of the tracking steps. Unless noted, ORB-SLAM2's values
+// (Tracking::TrackWithMotionModel, TrackReferenceKeyFrame, Relocalization, UpdateLocalKeyFrames,
+// SearchLocalPoints, NeedNewKeyFrame, CreateNewKeyFrame).
+constexpr int kMinMotionMatches = 20;      // motion model: matches (else the window is doubled)
+constexpr int kMinMapMatches = 10;         // motion model / reference keyframe: matches to map points
+constexpr double kRefBowRatio = 0.7;       // reference keyframe: SearchByBoW nearest-neighbour ratio
+constexpr int kMinBowMatches = 15;         // reference keyframe / relocalisation: SearchByBoW matches
+// Reference keyframe without (enough) BoW matches: projection windows and the matches that end
+// the widening (this project's choice; ORB-SLAM2 has no such fallback).
+constexpr double kRefWindows[] = {5.0, 10.0};
+constexpr int kRefWindowEnough = 20;
+constexpr double kProjectionRatio = 0.9;   // projection searches against one keyframe
+// Lost without relocalisation: the last reference keyframe's best covisibles tried, and the
+// map matches one needs (this project's choice).
+constexpr size_t kLostCovisibles = 10;
+constexpr int kLostMinMapMatches = 30;
+// Relocalisation: candidates tried (this project's cap on the cost of a lost frame), SearchByBoW
+// ratio, PnP RANSAC (ORB-SLAM2 PnPsolver: 300 iterations, 0.99 confidence, 10 inliers; its chi2
+// bound 5.991 serves as OpenCV's pixel error), inliers to accept (50), to retry with the narrow
+// window (30), windows (10, 3).
+constexpr size_t kMaxRelocCandidates = 20;
+constexpr double kRelocBowRatio = 0.75;
+constexpr int kPnpIterations = 300;
+constexpr float kPnpReprojError = 5.991f;
+constexpr double kPnpConfidence = 0.99;
+constexpr int kPnpMinInliers = 10;
+constexpr int kRelocMinInliers = 50;
+constexpr int kRelocRetryMinInliers = 30;
+constexpr double kRelocWindowWide = 10.0;
+constexpr double kRelocWindowNarrow = 3.0;
+// Local map: keyframes at most, covisibles per keyframe, minimum viewing cosine, NN ratio.
+constexpr size_t kMaxLocalKeyFrames = 80;
+constexpr size_t kLocalCovisibles = 10;
+constexpr double kLocalViewCos = 0.5;
+constexpr double kLocalRatio = 0.8;
+// Keyframe decision: reference ratio with a map of one keyframe, share of the reference's points
+// below which a keyframe is due anyway, and the inliers a keyframe needs.
+constexpr double kRefRatioFirst = 0.4;
+constexpr double kRefRatioLow = 0.25;
+constexpr int kKeyFrameMinInliers = 15;
+constexpr int kMinClosePoints = 100;       // close points a new keyframe makes map points of
+
 bool finitePose(const Pose& T) { return T.matrix().allFinite(); }
+
+Pose poseFromRodrigues(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Pose T = Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T.linear()(r, c) = R.at<double>(r, c);
+    T.translation()(r) = tvec.at<double>(r);
+  }
+  return T;
+}
+
+// Releases the outlier associations of F (and clears their flags).
+void releaseOutliers(Frame& F) {
+  for (int i = 0; i < F.N; ++i)
+    if (F.points[i] && F.outlier[i]) {
+      F.points[i].reset();
+      F.outlier[i] = false;
+    }
+}
+
+// Drops F's associations to points erased or fused by local mapping.
+void dropBadPoints(Frame& F) {
+  for (auto& mp : F.points)
+    if (mp && mp->bad) mp.reset();
+}
+
+void clearAssociations(Frame& F) {
+  std::fill(F.points.begin(), F.points.end(), nullptr);
+  std::fill(F.outlier.begin(), F.outlier.end(), false);
+}
+
 }  // namespace
 
 Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map, LocalMapping* mapper,
@@ -42,19 +118,22 @@ Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map,
   min_frames_ = opt_.min_frames_between_kf;
 }
 
-void Tracking::computeBow(Frame& F) const {
-  if (!voc_ || !F.bow.empty() || F.N == 0) return;
-  voc_->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
-}
-
 TrackResult Tracking::track(const features::FeatureFrame& ff) {
   reset_requested_ = false;
   ++frames_;
   Frame F(ff, cam_, geom_, pyr_, next_frame_id_++);
+  checkTimestamp(F);
+  if (state_ == TrackingState::NotInitialized) return trackFirst(F);
+  updateLastFrame();
   TrackResult res;
+  if (trackFrame(F)) onTracked(F, res);
+  else onFailed(res);
+  return res;
+}
 
+void Tracking::checkTimestamp(const Frame& F) {
   // A timestamp that goes backwards or jumps invalidates the constant-velocity prediction.
-  bool stamp_ok = std::isfinite(F.stamp);
+  const bool stamp_ok = std::isfinite(F.stamp);
   if (stamp_ok && has_last_stamp_) {
     const double dt = F.stamp - last_stamp_;
     if (!(dt > 0) || dt > opt_.max_stamp_gap) {
@@ -68,100 +147,92 @@ TrackResult Tracking::track(const features::FeatureFrame& ff) {
     last_stamp_ = F.stamp;
     has_last_stamp_ = true;
   }
+}
 
-  if (state_ == TrackingState::NotInitialized) {
-    if (initialize(F)) {
-      state_ = TrackingState::Ok;
-      res.state = TrackingState::Ok;
-      res.T_wc = F.Twc();
-      res.inliers = F.countWithDepth();
-      res.keyframe_inserted = true;
-      ++tracked_;
-      record(F);
-      last_ = F;
-      has_last_ = true;
-      last_good_T_wc_ = F.Twc();
-      has_last_good_ = true;
-    } else {
-      ++lost_;
-      res.state = TrackingState::NotInitialized;
-    }
+TrackResult Tracking::trackFirst(Frame& F) {
+  TrackResult res;
+  if (!initialize(F)) {
+    ++lost_;
+    res.state = TrackingState::NotInitialized;
     return res;
   }
+  state_ = TrackingState::Ok;
+  res.inliers = F.countWithDepth();
+  res.keyframe_inserted = true;
+  acceptFrame(F, res);
+  return res;
+}
 
-  // Points of the last frame may have been fused or culled by local mapping.
-  if (has_last_) {
-    for (auto& p : last_.points) {
-      if (!p) continue;
-      if (p->bad) p = MapPoint::resolve(p);
-    }
-  }
-  updateLastFrame();
-
+bool Tracking::trackFrame(Frame& F) {
   bool ok = false;
   if (state_ == TrackingState::Ok && has_last_) {
     if (has_velocity_) ok = trackMotionModel(F);
     if (!ok && ref_kf_ && !ref_kf_->bad)
-      ok = trackReferenceKeyFrame(F, ref_kf_, last_.T_cw, 10);
+      ok = trackReferenceKeyFrame(F, ref_kf_, last_.T_cw, kMinMapMatches);
   } else {
     ok = trackWhenLost(F);
   }
   if (ok) ok = trackLocalMap(F);
-  if (ok && !finitePose(F.T_cw)) ok = false;
+  return ok && finitePose(F.T_cw);
+}
 
-  if (ok) {
-    const bool was_lost = state_ == TrackingState::Lost;
-    failures_in_row_ = 0;
-    lost_frames_in_row_ = 0;
-    state_ = TrackingState::Ok;
-    // After a lost stretch the last tracked frame is far in the past: no velocity from it.
-    if (has_last_ && !was_lost) {
-      velocity_ = F.T_cw * last_.T_cw.inverse();
-      has_velocity_ = finitePose(velocity_);
-    }
-    // Drop associations to temporary visual-odometry points.
-    for (int i = 0; i < F.N; ++i) {
-      if (F.points[i] && F.points[i]->numObservations() < 1) {
-        F.points[i].reset();
-        F.outlier[i] = false;
-      }
-    }
-    temporary_points_.clear();
-    if (!localization_only_ && needNewKeyFrame(F)) {
-      createNewKeyFrame(F);
-      res.keyframe_inserted = true;
-    }
-    // Outliers are not carried to the next frame (they stayed in the keyframe if one was made).
-    for (int i = 0; i < F.N; ++i)
-      if (F.points[i] && F.outlier[i]) F.points[i].reset();
-    ++tracked_;
-    res.state = TrackingState::Ok;
-    res.T_wc = F.Twc();
-    res.inliers = inliers_;
-    record(F);
-    last_ = F;
-    has_last_ = true;
-    last_good_T_wc_ = F.Twc();
-    has_last_good_ = true;
-  } else {
-    temporary_points_.clear();
-    ++lost_;
-    ++failures_in_row_;
-    ++lost_frames_in_row_;
-    res.state = TrackingState::Lost;
-    res.inliers = inliers_;
-    // One bad frame (blur, a glitch) is skipped; two in a row mean lost (the velocity is
-    // no longer trustworthy).
-    if (failures_in_row_ >= 2 || state_ == TrackingState::Lost) {
-      state_ = TrackingState::Lost;
-      has_velocity_ = false;
-    }
-    if (state_ == TrackingState::Lost && lost_frames_in_row_ >= opt_.lost_reset_frames &&
-        static_cast<int>(map_.numKeyFrames()) <= opt_.lost_reset_max_keyframes && !localization_only_) {
-      reset_requested_ = true;
+void Tracking::onTracked(Frame& F, TrackResult& res) {
+  const bool was_lost = state_ == TrackingState::Lost;
+  failures_in_row_ = 0;
+  lost_frames_in_row_ = 0;
+  state_ = TrackingState::Ok;
+  // After a lost stretch the last tracked frame is far in the past: no velocity from it.
+  if (has_last_ && !was_lost) {
+    velocity_ = F.T_cw * last_.T_cw.inverse();
+    has_velocity_ = finitePose(velocity_);
+  }
+  // Drop associations to temporary visual-odometry points.
+  for (int i = 0; i < F.N; ++i) {
+    if (F.points[i] && F.points[i]->numObservations() < 1) {
+      F.points[i].reset();
+      F.outlier[i] = false;
     }
   }
-  return res;
+  temporary_points_.clear();
+  if (!localization_only_ && needNewKeyFrame(F)) {
+    createNewKeyFrame(F);
+    res.keyframe_inserted = true;
+  }
+  // Outliers are not carried to the next frame (they stayed in the keyframe if one was made).
+  for (int i = 0; i < F.N; ++i)
+    if (F.points[i] && F.outlier[i]) F.points[i].reset();
+  acceptFrame(F, res);
+  res.inliers = inliers_;
+}
+
+void Tracking::onFailed(TrackResult& res) {
+  temporary_points_.clear();
+  ++lost_;
+  ++failures_in_row_;
+  ++lost_frames_in_row_;
+  res.state = TrackingState::Lost;
+  res.inliers = inliers_;
+  // One bad frame (blur, a glitch) is skipped; two in a row mean lost (the velocity is
+  // no longer trustworthy).
+  if (failures_in_row_ >= 2 || state_ == TrackingState::Lost) {
+    state_ = TrackingState::Lost;
+    has_velocity_ = false;
+  }
+  if (state_ == TrackingState::Lost && lost_frames_in_row_ >= opt_.lost_reset_frames &&
+      static_cast<int>(map_.numKeyFrames()) <= opt_.lost_reset_max_keyframes && !localization_only_) {
+    reset_requested_ = true;
+  }
+}
+
+void Tracking::acceptFrame(const Frame& F, TrackResult& res) {
+  ++tracked_;
+  res.state = TrackingState::Ok;
+  res.T_wc = F.Twc();
+  record(F);
+  last_ = F;
+  has_last_ = true;
+  last_good_T_wc_ = F.Twc();
+  has_last_good_ = true;
 }
 
 bool Tracking::initialize(Frame& F) {
@@ -170,7 +241,7 @@ bool Tracking::initialize(Frame& F) {
   if (n_static < opt_.init_min_keypoints || F.countWithDepth() < opt_.init_min_depth_points) return false;
   F.setPose(has_last_good_ ? last_good_T_wc_.inverse() : Pose::Identity());
   auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
-  computeBow(kf->f);
+  computeBow(voc_.get(), kf->f);
   map_.addKeyFrame(kf);
   for (int i = 0; i < F.N; ++i) {
     if (F.depth[i] <= 0 || F.dynamic[i]) continue;
@@ -178,7 +249,6 @@ bool Tracking::initialize(Frame& F) {
   }
   if (mapper_) mapper_->insertKeyFrame(kf);
   ref_kf_ = kf;
-  last_kf_ = kf;
   last_kf_frame_id_ = F.id;
   local_kfs_ = {kf};
   local_points_ = kf->mapPoints();
@@ -188,18 +258,21 @@ bool Tracking::initialize(Frame& F) {
 }
 
 void Tracking::updateLastFrame() {
-  if (!has_last_ || !last_ref_ ) return;
+  if (!has_last_) return;
+  // Points of the last frame may have been fused or culled by local mapping.
+  for (auto& p : last_.points)
+    if (p && p->bad) p = MapPoint::resolve(p);
+  if (!last_ref_) return;
   // The reference keyframe may have been refined by local BA since.
-  KeyFramePtr ref = last_ref_;
-  Pose T_rr = Pose::Identity();
-  while (ref && ref->bad) {
-    T_rr = T_rr * ref->T_cp;  // T_{ref_old, parent}
-    ref = ref->parent;
-  }
+  Pose T_rr = Pose::Identity();  // T_{ref_old, ref}
+  const KeyFramePtr ref = liveAncestor(last_ref_, &T_rr);
   if (ref) last_.setPose(T_lr_ * T_rr * ref->Tcw());
   // ORB-SLAM2 creates temporary close points in the last frame only in localization mode,
   // where no keyframes (and so no new map points) are made.
-  if (!localization_only_ || last_kf_frame_id_ == last_.id) return;
+  if (localization_only_ && last_kf_frame_id_ != last_.id) addTemporaryPoints();
+}
+
+void Tracking::addTemporaryPoints() {
   const std::vector<std::pair<float, int>> by_depth = last_.staticByDepth();
   int n = 0;
   for (const auto& e : by_depth) {
@@ -228,12 +301,7 @@ int Tracking::optimizePose(Frame& F) {
   for (int i = 0; i < F.N; ++i) {
     const MapPointPtr& mp = F.points[i];
     if (!mp || F.dynamic[i]) continue;
-    optimization::PoseObservation o;
-    o.Xw = mp->Xw;
-    o.uv = Eigen::Vector2d(F.kps[i].pt.x, F.kps[i].pt.y);
-    o.u_right = F.right_u[i] >= 0 ? F.right_u[i] : -1.0;
-    o.inv_sigma2 = pyr_->inv_sigma2[F.kps[i].octave];
-    obs.push_back(o);
+    obs.push_back(poseObservation(F, i, mp->Xw));
     idx.push_back(i);
   }
   if (obs.size() < 3) return 0;
@@ -250,14 +318,14 @@ bool Tracking::trackMotionModel(Frame& F) {
   F.setPose(velocity_ * last_.T_cw);
   std::fill(F.points.begin(), F.points.end(), nullptr);
   int n = matcher::searchLastFrame(F, last_, opt_.motion_window);
-  if (n < 20) {
+  if (n < kMinMotionMatches) {
     std::fill(F.points.begin(), F.points.end(), nullptr);
     n = matcher::searchLastFrame(F, last_, 2.0 * opt_.motion_window);
   }
-  if (n < 20) return false;
+  if (n < kMinMotionMatches) return false;
   const int n_map = optimizePoseAndDropOutliers(F);
-  if (localization_only_) return n_map >= 10 || n >= 20;
-  return n_map >= 10;
+  if (localization_only_) return n_map >= kMinMapMatches || n >= kMinMotionMatches;
+  return n_map >= kMinMapMatches;
 }
 
 bool Tracking::createDepthPoint(const KeyFramePtr& kf, Frame& F, int i) {
@@ -291,33 +359,39 @@ int Tracking::optimizePoseAndDropOutliers(Frame& F) {
 
 bool Tracking::trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior,
                                       int min_inliers) {
-  std::fill(F.points.begin(), F.points.end(), nullptr);
-  std::fill(F.outlier.begin(), F.outlier.end(), false);
+  clearAssociations(F);
   F.setPose(prior);
   int n = 0;
   if (voc_) {
-    computeBow(F);
-    if (kf->f.bow.empty()) computeBow(kf->f);
-    n = matcher::searchByBow(*kf, F, 0.7);
+    computeBow(voc_.get(), F);
+    computeBow(voc_.get(), kf->f);
+    n = matcher::searchByBow(*kf, F, kRefBowRatio);
   }
-  if (n < 15) {
+  if (n < kMinBowMatches) {
     // Without BoW (or when it finds too little): projection of the keyframe's points with the
     // prior pose, widening the window once.
-    for (double th : {5.0, 10.0}) {
+    for (double th : kRefWindows) {
       std::fill(F.points.begin(), F.points.end(), nullptr);
-      std::vector<matcher::Projection> proj;
-      for (const auto& mp : kf->mapPoints()) {
-        if (mp->dynamic) continue;
-        matcher::Projection p;
-        if (matcher::projectInFrame(F, mp, 0.0, p)) proj.push_back(p);
-      }
-      n = matcher::searchProjections(F, proj, th, 0.9);
-      if (n >= 20) break;
+      n = searchKeyFramePoints(F, *kf, th);
+      if (n >= kRefWindowEnough) break;
     }
   }
-  if (n < 15) return false;
+  if (n < kMinBowMatches) return false;
   const int n_map = optimizePoseAndDropOutliers(F);
   return n_map >= min_inliers;
+}
+
+int Tracking::searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const {
+  std::set<long> have;
+  for (const auto& mp : F.points)
+    if (mp) have.insert(mp->id);
+  std::vector<matcher::Projection> proj;
+  for (const auto& mp : kf.mapPoints()) {
+    if (mp->dynamic || have.count(mp->id)) continue;
+    matcher::Projection p;
+    if (matcher::projectInFrame(F, mp, 0.0, p)) proj.push_back(p);
+  }
+  return matcher::searchProjections(F, proj, th, kProjectionRatio);
 }
 
 bool Tracking::trackWhenLost(Frame& F) {
@@ -326,16 +400,15 @@ bool Tracking::trackWhenLost(Frame& F) {
   if (relocalize(F)) return true;
   if (!has_last_good_) return false;
   std::vector<KeyFramePtr> cands;
-  KeyFramePtr ref = ref_kf_;
-  while (ref && ref->bad) ref = ref->parent;
+  const KeyFramePtr ref = liveAncestor(ref_kf_);
   if (ref) {
     cands.push_back(ref);
-    for (const auto& k : ref->bestCovisibles(10)) cands.push_back(k);
+    for (const auto& k : ref->bestCovisibles(kLostCovisibles)) cands.push_back(k);
   }
   const Pose prior = last_good_T_wc_.inverse();
   for (const auto& kf : cands) {
     if (kf->bad) continue;
-    if (trackReferenceKeyFrame(F, kf, prior, 30)) {
+    if (trackReferenceKeyFrame(F, kf, prior, kLostMinMapMatches)) {
       ref_kf_ = kf;
       return true;
     }
@@ -346,7 +419,7 @@ bool Tracking::trackWhenLost(Frame& F) {
 bool Tracking::relocalize(Frame& F) {
   vocabulary::KeyFrameDatabase* db = map_.keyFrameDatabase();
   if (!voc_ || !db || F.N == 0) return false;
-  computeBow(F);
+  computeBow(voc_.get(), F);
   if (F.bow.empty()) return false;
 
   // Candidates (ORB-SLAM2 DetectRelocalizationCandidates): keyframes sharing enough words, then
@@ -355,113 +428,85 @@ bool Tracking::relocalize(Frame& F) {
   const auto hits = db->query(F.bow.bow, 0);
   if (hits.empty()) return false;
   std::vector<KeyFramePtr> cands = covisibilityGroupCandidates(map_, hits);
-  if (cands.size() > 20) cands.resize(20);
-
-  cv::Mat K = (cv::Mat_<double>(3, 3) << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1);
+  if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
   for (const KeyFramePtr& kf : cands) {
-    if (kf->f.bow.empty()) computeBow(kf->f);
-    std::fill(F.points.begin(), F.points.end(), nullptr);
-    std::fill(F.outlier.begin(), F.outlier.end(), false);
-    if (matcher::searchByBow(*kf, F, 0.75) < 15) continue;
-
-    // PnP RANSAC on the BoW matches (undistorted keypoints: no distortion coefficients).
-    std::vector<cv::Point3f> obj;
-    std::vector<cv::Point2f> img;
-    std::vector<int> idx;
-    for (int i = 0; i < F.N; ++i) {
-      const MapPointPtr& mp = F.points[i];
-      if (!mp || mp->bad) continue;
-      obj.emplace_back(static_cast<float>(mp->Xw.x()), static_cast<float>(mp->Xw.y()),
-                       static_cast<float>(mp->Xw.z()));
-      img.push_back(F.kps[i].pt);
-      idx.push_back(i);
-    }
-    if (obj.size() < 15) continue;
-    cv::Mat rvec, tvec;
-    std::vector<int> inl;
-    bool ok = false;
-    try {
-      ok = cv::solvePnPRansac(obj, img, K, cv::noArray(), rvec, tvec, false, 300, 5.991f, 0.99, inl,
-                              cv::SOLVEPNP_EPNP);
-    } catch (const cv::Exception&) {
-      ok = false;
-    }
-    if (!ok || inl.size() < 10) continue;
-    cv::Mat R;
-    cv::Rodrigues(rvec, R);
-    Pose T = Pose::Identity();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) T.linear()(r, c) = R.at<double>(r, c);
-      T.translation()(r) = tvec.at<double>(r);
-    }
-    if (!finitePose(T)) continue;
-    std::vector<bool> keep(F.N, false);
-    for (int k : inl) keep[idx[k]] = true;
-    for (int i = 0; i < F.N; ++i)
-      if (!keep[i]) F.points[i].reset();
-    F.setPose(T);
-
-    int good = optimizePose(F);
-    if (good < 10) continue;
-    for (int i = 0; i < F.N; ++i)
-      if (F.points[i] && F.outlier[i]) {
-        F.points[i].reset();
-        F.outlier[i] = false;
-      }
-    // Few inliers: look for more by projecting the candidate's points (ORB-SLAM2 window 10,
-    // then 3 with the refined pose).
-    auto project_kf = [&](double th) {
-      std::set<long> have;
-      for (const auto& mp : F.points)
-        if (mp) have.insert(mp->id);
-      std::vector<matcher::Projection> proj;
-      for (const auto& mp : kf->mapPoints()) {
-        if (mp->dynamic || have.count(mp->id)) continue;
-        matcher::Projection p;
-        if (matcher::projectInFrame(F, mp, 0.0, p)) proj.push_back(p);
-      }
-      return matcher::searchProjections(F, proj, th, 0.9);
-    };
-    if (good < 50) {
-      if (project_kf(10.0) + good >= 50) {
-        good = optimizePose(F);
-        if (good > 30 && good < 50) {
-          for (int i = 0; i < F.N; ++i)
-            if (F.points[i] && F.outlier[i]) F.points[i].reset();
-          if (project_kf(3.0) + good >= 50) good = optimizePose(F);
-        }
-      }
-    }
-    if (good < 50) continue;
-    for (int i = 0; i < F.N; ++i)
-      if (F.points[i] && F.outlier[i]) {
-        F.points[i].reset();
-        F.outlier[i] = false;
-      }
+    if (!relocalizeOn(F, kf)) continue;
     ref_kf_ = kf;
     last_reloc_frame_id_ = F.id;
     has_velocity_ = false;
     ++relocalizations_;
     return true;
   }
-  std::fill(F.points.begin(), F.points.end(), nullptr);
-  std::fill(F.outlier.begin(), F.outlier.end(), false);
+  clearAssociations(F);
   return false;
+}
+
+bool Tracking::relocalizeOn(Frame& F, const KeyFramePtr& kf) {
+  computeBow(voc_.get(), kf->f);
+  clearAssociations(F);
+  if (matcher::searchByBow(*kf, F, kRelocBowRatio) < kMinBowMatches) return false;
+  if (!pnpPose(F)) return false;
+  int good = optimizePose(F);
+  if (good < kPnpMinInliers) return false;
+  releaseOutliers(F);
+  // Few inliers: look for more by projecting the candidate's points (ORB-SLAM2 window 10,
+  // then 3 with the refined pose).
+  if (good < kRelocMinInliers && searchKeyFramePoints(F, *kf, kRelocWindowWide) + good >= kRelocMinInliers) {
+    good = optimizePose(F);
+    if (good > kRelocRetryMinInliers && good < kRelocMinInliers) {
+      for (int i = 0; i < F.N; ++i)
+        if (F.points[i] && F.outlier[i]) F.points[i].reset();
+      if (searchKeyFramePoints(F, *kf, kRelocWindowNarrow) + good >= kRelocMinInliers) good = optimizePose(F);
+    }
+  }
+  if (good < kRelocMinInliers) return false;
+  releaseOutliers(F);
+  return true;
+}
+
+bool Tracking::pnpPose(Frame& F) const {
+  // PnP RANSAC on the BoW matches (undistorted keypoints: no distortion coefficients).
+  std::vector<cv::Point3f> obj;
+  std::vector<cv::Point2f> img;
+  std::vector<int> idx;
+  for (int i = 0; i < F.N; ++i) {
+    const MapPointPtr& mp = F.points[i];
+    if (!mp || mp->bad) continue;
+    obj.emplace_back(static_cast<float>(mp->Xw.x()), static_cast<float>(mp->Xw.y()),
+                     static_cast<float>(mp->Xw.z()));
+    img.push_back(F.kps[i].pt);
+    idx.push_back(i);
+  }
+  if (static_cast<int>(obj.size()) < kMinBowMatches) return false;
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1);
+  cv::Mat rvec, tvec;
+  std::vector<int> inl;
+  bool ok = false;
+  try {
+    ok = cv::solvePnPRansac(obj, img, K, cv::noArray(), rvec, tvec, false, kPnpIterations, kPnpReprojError,
+                            kPnpConfidence, inl, cv::SOLVEPNP_EPNP);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok || static_cast<int>(inl.size()) < kPnpMinInliers) return false;
+  const Pose T = poseFromRodrigues(rvec, tvec);
+  if (!finitePose(T)) return false;
+  std::vector<bool> keep(F.N, false);
+  for (int k : inl) keep[idx[k]] = true;
+  for (int i = 0; i < F.N; ++i)
+    if (!keep[i]) F.points[i].reset();
+  F.setPose(T);
+  return true;
 }
 
 void Tracking::updateLocalMap(Frame& F) {
   // Local keyframes: those sharing points with the frame, plus their best covisibles,
   // a child and the parent (ORB-SLAM2 UpdateLocalKeyFrames).
+  dropBadPoints(F);
   std::map<KeyFramePtr, int, ById> counter;
-  for (int i = 0; i < F.N; ++i) {
-    MapPointPtr& mp = F.points[i];
-    if (!mp) continue;
-    if (mp->bad) {
-      mp.reset();
-      continue;
-    }
-    for (const auto& o : mp->observations) counter[o.first]++;
-  }
+  for (const auto& mp : F.points)
+    if (mp)
+      for (const auto& o : mp->observations) counter[o.first]++;
   if (counter.empty()) return;
   local_kfs_.clear();
   std::set<long> in_local;
@@ -477,9 +522,9 @@ void Tracking::updateLocalMap(Frame& F) {
     in_local.insert(c.first->id);
   }
   const size_t n_direct = local_kfs_.size();
-  for (size_t k = 0; k < n_direct && local_kfs_.size() < 80; ++k) {
+  for (size_t k = 0; k < n_direct && local_kfs_.size() < kMaxLocalKeyFrames; ++k) {
     KeyFramePtr kf = local_kfs_[k];
-    for (const auto& nb : kf->bestCovisibles(10)) {
+    for (const auto& nb : kf->bestCovisibles(kLocalCovisibles)) {
       if (!nb->bad && in_local.insert(nb->id).second) {
         local_kfs_.push_back(nb);
         break;
@@ -507,13 +552,9 @@ void Tracking::updateLocalMap(Frame& F) {
 }
 
 void Tracking::searchLocalPoints(Frame& F) {
-  for (int i = 0; i < F.N; ++i) {
-    MapPointPtr& mp = F.points[i];
+  dropBadPoints(F);
+  for (const auto& mp : F.points) {
     if (!mp) continue;
-    if (mp->bad) {
-      mp.reset();
-      continue;
-    }
     mp->visible++;
     mp->last_seen_frame = F.id;
   }
@@ -521,14 +562,14 @@ void Tracking::searchLocalPoints(Frame& F) {
   for (const auto& mp : local_points_) {
     if (mp->last_seen_frame == F.id || mp->bad) continue;
     matcher::Projection p;
-    if (matcher::projectInFrame(F, mp, 0.5, p)) {
+    if (matcher::projectInFrame(F, mp, kLocalViewCos, p)) {
       mp->visible++;
       proj.push_back(p);
     }
   }
   if (proj.empty()) return;
   dynamic_hits_.clear();
-  matcher::searchProjections(F, proj, opt_.local_window, 0.8, &dynamic_hits_);
+  matcher::searchProjections(F, proj, opt_.local_window, kLocalRatio, &dynamic_hits_);
 }
 
 bool Tracking::trackLocalMap(Frame& F) {
@@ -568,11 +609,11 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
     else ++untracked_close;
   }
   const bool need_close = tracked_close < opt_.close_tracked_max && untracked_close > opt_.close_untracked_min;
-  const double ratio = n_kfs < 2 ? 0.4 : opt_.ref_ratio;
+  const double ratio = n_kfs < 2 ? kRefRatioFirst : opt_.ref_ratio;
   const bool c1a = F.id >= last_kf_frame_id_ + max_frames_;
   const bool c1b = F.id >= last_kf_frame_id_ + min_frames_ && idle;
-  const bool c1c = inliers_ < ref_matches * 0.25 || need_close;
-  const bool c2 = (inliers_ < ref_matches * ratio || need_close) && inliers_ > 15;
+  const bool c1c = inliers_ < ref_matches * kRefRatioLow || need_close;
+  const bool c2 = (inliers_ < ref_matches * ratio || need_close) && inliers_ > kKeyFrameMinInliers;
   if (!((c1a || c1b || c1c) && c2)) return false;
   if (idle) return true;
   mapper_->interruptBA();
@@ -581,7 +622,7 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
 
 void Tracking::createNewKeyFrame(Frame& F) {
   auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
-  computeBow(kf->f);
+  computeBow(voc_.get(), kf->f);
   ref_kf_ = kf;
   // Close points with depth become map points right away (ORB-SLAM2 CreateNewKeyFrame):
   // the closest ones first, all those nearer than ThDepth, at least 100.
@@ -594,7 +635,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
       if (!createDepthPoint(kf, F, i)) continue;
     }
     ++n;
-    if (e.first > cam_.closeDepth() && n > 100) break;
+    if (e.first > cam_.closeDepth() && n > kMinClosePoints) break;
   }
   // Map points that now project onto a dynamic keypoint are marked in this keyframe: they are
   // on something that moves and are no longer used for tracking.
@@ -602,7 +643,6 @@ void Tracking::createNewKeyFrame(Frame& F) {
     if (mp && !mp->bad) mp->dynamic = true;
   dynamic_hits_.clear();
   mapper_->insertKeyFrame(kf);
-  last_kf_ = kf;
   last_kf_frame_id_ = F.id;
 }
 
@@ -628,12 +668,8 @@ Trajectory Tracking::trajectory() const {
     sp.T_wc = r.T_wc;
     if (r.ref) {
       // Follow erased keyframes to their parents (their pose relative to the parent is kept).
-      KeyFramePtr ref = r.ref;
       Pose T_rr = Pose::Identity();
-      while (ref && ref->bad) {
-        T_rr = T_rr * ref->T_cp;
-        ref = ref->parent;
-      }
+      const KeyFramePtr ref = liveAncestor(r.ref, &T_rr);
       if (ref) sp.T_wc = (r.T_cr * T_rr * ref->Tcw()).inverse();
     }
     if (finitePose(sp.T_wc)) out.push_back(sp);
@@ -655,7 +691,6 @@ void Tracking::resetKeepTrajectory() {
   has_last_ = false;
   last_ = Frame();
   ref_kf_.reset();
-  last_kf_.reset();
   last_ref_.reset();
   last_kf_frame_id_ = -1;
   has_velocity_ = false;

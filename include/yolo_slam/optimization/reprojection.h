@@ -17,6 +17,9 @@ namespace optimization {
 constexpr double kChi2Mono = 5.991;
 constexpr double kChi2Stereo = 7.815;
 
+// The chi2 bound of an observation: 3 rows with a right coordinate (u_right >= 0), else 2.
+inline double chi2Threshold(double u_right) { return u_right >= 0 ? kChi2Stereo : kChi2Mono; }
+
 struct Intrinsics {
   double fx, fy, cx, cy, bf;
   static Intrinsics from(const CameraModel& c) { return {c.fx, c.fy, c.cx, c.cy, c.bf}; }
@@ -88,6 +91,20 @@ class BaCost final : public ceres::SizedCostFunction<kRows, 7, 3> {
   Eigen::Matrix<double, kRows, 1> obs_;
   double sqrt_info_;
 };
+
+// The residual of one observation: 3 rows (u, v, u_right) with a right coordinate
+// (u_right >= 0), else 2 (u, v). The caller (or the problem) owns the result.
+inline ceres::CostFunction* newPoseOnlyCost(const Intrinsics& K, const Eigen::Vector3d& Xw,
+                                            const Eigen::Vector2d& uv, double u_right, double inv_sigma2,
+                                            const bool* active) {
+  if (u_right < 0) return new PoseOnlyCost<2>(K, Xw, uv, inv_sigma2, active);
+  return new PoseOnlyCost<3>(K, Xw, Eigen::Vector3d(uv.x(), uv.y(), u_right), inv_sigma2, active);
+}
+inline ceres::CostFunction* newBaCost(const Intrinsics& K, const Eigen::Vector2d& uv, double u_right,
+                                      double inv_sigma2) {
+  if (u_right < 0) return new BaCost<2>(K, uv, inv_sigma2);
+  return new BaCost<3>(K, Eigen::Vector3d(uv.x(), uv.y(), u_right), inv_sigma2);
+}
 
 }  // namespace optimization
 }  // namespace yolo_slam

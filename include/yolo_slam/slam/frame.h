@@ -13,6 +13,9 @@
 #include <vector>
 
 namespace yolo_slam {
+namespace vocabulary {
+class Vocabulary;
+}
 namespace slam {
 
 // Scale pyramid data of the ORB extractor (same formulas as features::OrbExtractor).
@@ -31,6 +34,9 @@ struct FrameGeometry {
   double min_x = 0, max_x = 640, min_y = 0, max_y = 480;
   double inv_cell_w = 0, inv_cell_h = 0;
   static FrameGeometry make(const CameraModel& cam);
+  bool outside(const Eigen::Vector2d& uv) const {
+    return uv.x() < min_x || uv.x() > max_x || uv.y() < min_y || uv.y() > max_y;
+  }
 };
 
 class Frame {
@@ -55,14 +61,13 @@ class Frame {
   std::vector<bool> outlier;       // set by pose optimisation
   BowData bow;                     // filled only when a vocabulary is used
 
-  bool has_pose = false;
   Pose T_cw = Pose::Identity();
 
   CameraModel cam;
   FrameGeometry geom;
   std::shared_ptr<const ScalePyramid> pyramid;
 
-  void setPose(const Pose& T) { T_cw = T; has_pose = true; }
+  void setPose(const Pose& T) { T_cw = T; }
   Pose Twc() const { return T_cw.inverse(); }
   Eigen::Vector3d cameraCenter() const { return T_cw.inverse().translation(); }
 
@@ -72,7 +77,6 @@ class Frame {
                                      int max_level = -1, bool dynamic_only = false) const;
   // World point of keypoint i from its depth (requires a pose and depth > 0).
   bool unprojectWorld(size_t i, Eigen::Vector3d& Xw) const;
-  bool usable(size_t i) const { return !dynamic[i]; }
   // Number of keypoints (static) with valid depth.
   int countWithDepth() const;
   // Static keypoints with valid depth as (depth, index), nearest first: ORB-SLAM2 turns the
@@ -82,6 +86,10 @@ class Frame {
  private:
   std::vector<std::vector<uint32_t>> grid_;  // kGridCols * kGridRows cells of keypoint indices
 };
+
+// Fills F's BoW slot from its descriptors, unless already filled, F has no keypoints or there
+// is no vocabulary (null).
+void computeBow(const vocabulary::Vocabulary* voc, Frame& F);
 
 }  // namespace slam
 }  // namespace yolo_slam

@@ -20,7 +20,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const long frame_id;
   Frame f;                      // keypoints, grid, pose (f.T_cw), map points (f.points), BoW
 
-  // Covisibility graph: keyframes sharing >= 15 points (or the best one), weight = shared points.
+  // Covisibility graph: keyframes sharing >= kCovisibilityMinWeight points (or the best one),
+  // weight = shared points.
   std::map<KeyFramePtr, int, ById> connections;
   std::vector<KeyFramePtr> ordered_connections;   // by decreasing weight
   std::vector<int> ordered_weights;
@@ -29,21 +30,19 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   KeyFramePtr parent;
   std::set<KeyFrame*, ById> children;   // by id: deterministic iteration
   bool first_connection = true;
-  std::set<KeyFramePtr, ById> loop_edges;          // for loop closing (later issue)
+  std::set<KeyFramePtr, ById> loop_edges;          // closed loops (essential-graph edges)
   bool bad = false;
   bool not_erase = false;                          // protected from culling (loop closing)
   bool is_origin = false;                          // first keyframe of the map: never erased
   Pose T_cp = Pose::Identity();                    // pose relative to parent, kept when erased
-  long ba_local_for = -1, ba_fixed_for = -1;       // local BA scratch
 
   const Pose& Tcw() const { return f.T_cw; }
   Pose Twc() const { return f.T_cw.inverse(); }
   Eigen::Vector3d center() const { return f.T_cw.inverse().translation(); }
 
-  void addMapPoint(const MapPointPtr& mp, size_t idx) { f.points[idx] = mp; }
-  void eraseMapPointMatch(size_t idx) { f.points[idx].reset(); }
   std::vector<MapPointPtr> mapPoints() const;      // live, non-null
-  int trackedMapPoints(int min_obs) const;         // points with >= min_obs observations
+  // Points with >= min_obs observations, counted as MapPoint::weightedObservations.
+  int trackedMapPoints(int min_obs) const;
 
   // Rebuilds this keyframe's covisibility edges from its points (both directions) and, on the
   // first call, attaches it to the spanning tree under the best-covisible keyframe.
@@ -52,13 +51,15 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void eraseConnection(const KeyFramePtr& kf);
   void updateBestCovisibles();
   std::vector<KeyFramePtr> bestCovisibles(size_t n) const;
-  std::vector<KeyFramePtr> covisiblesByWeight(int w) const;
   int weight(const KeyFramePtr& kf) const;
-  // Median depth of the points seen (for baselines in triangulation).
-  double sceneMedianDepth() const;
 
   KeyFramePtr self() { return shared_from_this(); }
 };
+
+// The first live keyframe up the spanning tree from kf: kf itself unless erased (null if the
+// chain ends). T_kr (may be null) receives kf's pose relative to it: erased keyframes keep
+// their pose relative to the parent (T_cp). Caller holds Map::update_mutex.
+KeyFramePtr liveAncestor(KeyFramePtr kf, Pose* T_kr = nullptr);
 
 }  // namespace slam
 }  // namespace yolo_slam

@@ -81,6 +81,9 @@ class LocalMapping {
   // queue_mutex_ on entry and on return, released while processing).
   void processFront(std::unique_lock<std::mutex>& lk);
   bool pauseWanted() const { return pause_requested_.load() || loop_pause_.load(); }
+  // Sets a pause flag (and aborts a running local BA) / clears it under queue_mutex_.
+  void requestPause(std::atomic<bool>& flag);
+  void releasePause(std::atomic<bool>& flag);
   void processNewKeyFrame();
   void mapPointCulling();
   void createNewMapPoints();

@@ -23,6 +23,8 @@
 // mutex / LoopClosing::queue_mutex_ > KeyFrameDatabase mutex.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/geometry.h"
+#include "yolo_slam/optimization/bundle_adjustment.h"
+#include "yolo_slam/optimization/pose_graph.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/types.h"
 
@@ -31,7 +33,9 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <random>
 #include <thread>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -82,11 +86,59 @@ class LoopClosing {
   // Pops the front keyframe and processes it (lk holds queue_mutex_ on entry and on return,
   // released while processing).
   void processFront(std::unique_lock<std::mutex>& lk);
-  std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);   // caller holds update_mutex
-  bool computeSE3(const KeyFramePtr& kf, const std::vector<KeyFramePtr>& cands);  // idem
-  void correctLoop(const KeyFramePtr& kf);                         // takes update_mutex
+  struct Neighbourhood;
+  using Links = std::vector<std::pair<long, long>>;   // (keyframe id, keyframe id)
+
+  // Detection and verification: the caller holds update_mutex.
+  std::vector<KeyFramePtr> detectLoop(const KeyFramePtr& kf);
+  // The candidates whose covisibility group continues a consistent group (updates groups_).
+  std::vector<KeyFramePtr> consistentCandidates(const std::vector<KeyFramePtr>& cands);
+  // Verification of the candidates in turn; the first that passes is kept in matched_kf_,
+  // T_cw_corrected_, current_matches_ and loop_points_.
+  bool computeSE3(const KeyFramePtr& kf, const std::vector<KeyFramePtr>& cands);
+  bool verifyCandidate(const KeyFramePtr& kf, const KeyFramePtr& cand, const std::vector<uint8_t>& use1,
+                       std::mt19937& rng);
+  // False (and a message) when the correction of T_cw against kf's pose exceeds the drift bound.
+  bool withinDriftBound(const KeyFrame& kf, const KeyFrame& cand, const Pose& T_cw, double& corr_m,
+                        double& corr_deg) const;
+
+  // Correction: takes update_mutex (never while pausing LocalMapping); its steps 1-5 below run
+  // with it held.
+  void correctLoop(const KeyFramePtr& kf);
+  // 1. Moves the current keyframe's neighbourhood (and the points it sees) rigidly with it.
+  Neighbourhood moveNeighbourhood(const KeyFramePtr& kf);
+  // 2. Fuses the verified matches (the current keyframe's points become the loop side's), then
+  //    the loop side's points into the whole corrected neighbourhood.
+  void fuseCurrentMatches(const KeyFramePtr& kf);
+  void fuseLoopPoints(const std::vector<KeyFramePtr>& neighbourhood);
+  // 3. Adds the loop edge; returns the new covisibility links the fusion created (the loop
+  //    edges of the essential graph).
+  Links linkLoop(const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const Neighbourhood& n);
+  // 4. Essential graph (spanning tree, loop edges, strong covisibility, new links) optimised
+  //    from T_wc_start (the corrected poses); returns the optimised T_wc per keyframe.
+  std::vector<optimization::PoseGraphEdge> essentialGraphEdges(
+      const KeyFramePtr& kf, const KeyFramePtr& loop_kf, const std::vector<KeyFramePtr>& kfs,
+      const std::map<long, Pose>& T_wc, const std::map<long, Pose>& T_wc_meas, const Links& new_links) const;
+  std::map<long, Pose> optimizeEssentialGraph(const KeyFramePtr& kf, const KeyFramePtr& loop_kf,
+                                              const std::vector<KeyFramePtr>& kfs,
+                                              const std::map<long, Pose>& T_wc_start, const Neighbourhood& n,
+                                              const Links& new_links);
+  // 5. Writes the optimised poses back, and moves every point with its correcting keyframe.
+  void writeBackCorrection(const std::vector<KeyFramePtr>& kfs, const std::map<long, Pose>& T_wc_start,
+                           const std::map<long, Pose>& T_wc,
+                           const std::unordered_map<long, long>& corrected_by);
+
+  // Pauses LocalMapping and waits until it is paused; caller must NOT hold update_mutex.
+  void pauseMapping();
+  // Global BA: started with no lock held (Sequential: runs it to the end); runGlobalBA takes
+  // update_mutex for the copy and the write-back, inside which the three helpers below run.
+  void startGlobalBA(long loop_kf_id);
   void stopGlobalBA();
   void runGlobalBA(long loop_kf_id);
+  optimization::BaProblem globalProblem() const;
+  // Returns the correction T_wc_new * T_cw_old per keyframe written.
+  std::unordered_map<long, Pose> writeBackKeyFrames(const optimization::BaProblem& problem);
+  void writeBackPoints(const optimization::BaProblem& problem, const std::unordered_map<long, Pose>& corr);
 
   Map& map_;
   CameraModel cam_;

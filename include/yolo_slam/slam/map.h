@@ -80,7 +80,6 @@ class Map {
   size_t numKeyFrames() const { return keyframes_.size(); }
   size_t numMapPoints() const { return points_.size(); }
   KeyFramePtr origin() const { return origin_; }
-  long maxKeyFrameId() const { return keyframes_.empty() ? -1 : (*keyframes_.rbegin())->id; }
 
   // Drops everything, breaking the reference cycles first.
   void clear();

@@ -42,7 +42,7 @@ class LoopClosing;
 struct MapSnapshot {
   std::vector<Eigen::Vector3d> points;                 // static map points only, world frame
   Trajectory keyframes;                                // T_wc, sorted by keyframe id
-  std::vector<std::pair<int, int>> covisibility_edges; // indices into keyframes (weight >= 15)
+  std::vector<std::pair<int, int>> covisibility_edges; // indices into keyframes (weight >= kCovisibilityMinWeight)
 };
 
 // Boxes screened: from the detector, and carried by the BoxTracker (Screening.trackBoxes).

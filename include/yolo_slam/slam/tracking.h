@@ -62,15 +62,32 @@ class Tracking {
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
 
  private:
+  // All below run inside track(): the caller holds map.update_mutex.
+  void checkTimestamp(const Frame& F);
+  TrackResult trackFirst(Frame& F);   // not initialised yet: initialise on F
+  // Motion model, reference keyframe or (lost) relocalisation, then the local map.
+  bool trackFrame(Frame& F);
+  void onTracked(Frame& F, TrackResult& res);
+  void onFailed(TrackResult& res);
+  // F becomes the last (good) frame and is recorded in the trajectory.
+  void acceptFrame(const Frame& F, TrackResult& res);
   bool initialize(Frame& F);
   bool trackMotionModel(Frame& F);
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
+  // Projection search of kf's static points not yet matched in F, window th.
+  int searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const;
   bool trackWhenLost(Frame& F);
   // ORB-SLAM2 Relocalization: BoW candidates from the map's KeyFrameDatabase, SearchByBoW,
   // PnP RANSAC, pose optimisation, projection search for more matches; needs >= 50 inliers.
   bool relocalize(Frame& F);
+  bool relocalizeOn(Frame& F, const KeyFramePtr& kf);   // one candidate
+  // PnP RANSAC on F's associations; sets the pose and keeps the inliers' associations.
+  bool pnpPose(Frame& F) const;
   bool trackLocalMap(Frame& F);
+  // Re-anchors the last frame on its (possibly refined or erased) reference keyframe.
   void updateLastFrame();
+  // Localization mode: temporary close points in the last frame for visual odometry.
+  void addTemporaryPoints();
   void updateLocalMap(Frame& F);
   void searchLocalPoints(Frame& F);
   int optimizePose(Frame& F);
@@ -82,7 +99,6 @@ class Tracking {
   bool createDepthPoint(const KeyFramePtr& kf, Frame& F, int i);
   bool needNewKeyFrame(const Frame& F) const;
   void createNewKeyFrame(Frame& F);
-  void computeBow(Frame& F) const;
   void record(const Frame& F);
 
   CameraModel cam_;
@@ -100,7 +116,6 @@ class Tracking {
   Frame last_;
   bool has_last_ = false;
   KeyFramePtr ref_kf_;          // reference keyframe of the current frame
-  KeyFramePtr last_kf_;
   long last_kf_frame_id_ = -1;
   Pose T_lr_ = Pose::Identity();   // last frame relative to its reference keyframe
   KeyFramePtr last_ref_;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 namespace yolo_slam {
@@ -16,8 +17,8 @@ class Map;
 using KeyFramePtr = std::shared_ptr<KeyFrame>;
 using MapPointPtr = std::shared_ptr<MapPoint>;
 
-// Bag-of-words slot (filled when a vocabulary is loaded; used by relocalisation/loop closing
-// later and by reference-keyframe tracking): word -> weight, node -> feature indices.
+// Bag-of-words slot (filled when a vocabulary is loaded; used by reference-keyframe tracking,
+// relocalisation and loop closing): word -> weight, node -> feature indices.
 struct BowData {
   vocabulary::BowVector bow;
   vocabulary::FeatureVector features;
@@ -28,6 +29,10 @@ struct BowData {
 // (ORB-SLAM2 uses 4 on its 6-level vocabulary; the shipped k=10 L=4 one needs 2 for the same
 // node size: ~100 nodes).
 constexpr int kBowLevelsUp = 2;
+
+// Covisibility edges join keyframes sharing at least this many map points (ORB-SLAM2
+// KeyFrame::UpdateConnections).
+constexpr int kCovisibilityMinWeight = 15;
 
 // How LocalMapping and LoopClosing run (System.sequential): each in its own thread, or inline,
 // in the thread of the caller that drains their queues (System, after each tracked frame), so
@@ -40,6 +45,13 @@ struct ById {
   template <class P>
   bool operator()(const P& a, const P& b) const { return a->id < b->id; }
 };
+
+// A copy of `v` read under `m` (the counters and logs behind the threads' queue mutexes).
+template <class T>
+T lockedCopy(std::mutex& m, const T& v) {
+  std::lock_guard<std::mutex> lk(m);
+  return v;
+}
 
 }  // namespace slam
 }  // namespace yolo_slam
