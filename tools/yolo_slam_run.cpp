@@ -243,6 +243,7 @@ struct Prepared {
   cv::Mat mask;  // ground-truth dynamic mask (synthetic sequences), empty if none
   std::string mask_path;
   std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
+  bool detector_ran = true;  // false: async detection had no new result for this frame
 };
 
 std::string baseName(const std::string& path) {
@@ -502,6 +503,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
   const long expired_before = feed.expired();
   const detection::FrameBoxes fb = feed.take(newest, p.stamp);
   res.boxes_expired += feed.expired() - expired_before;
+  p.detector_ran = fb.fresh;
   if (!fb.fresh) return;
   ++res.boxes_fresh;
   p.boxes = fb.boxes;
@@ -516,7 +518,7 @@ void trackFrame(slam::System& system, const Prepared& p, std::ofstream& boxes_ou
     ++res.skipped;
     return;
   }
-  const slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes);
+  const slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes, p.detector_ran);
   if (r.state != slam::TrackingState::Ok) ++res.lost_reports;
   ++res.processed;
   if (boxes_out.is_open()) writeScreenedBoxes(boxes_out, p.stamp, system.lastBoxes());

@@ -30,7 +30,7 @@ FrontEnd::FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOp
       screening_(std::make_unique<screening::ScreeningPipeline>(screening)) {}
 
 FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                                 const detection::Boxes& boxes, const CameraModel& cam) {
+                                 const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
   if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
   const cv::Mat depth = checkedDepth(depth_m, image, stamp);
   FrontEndResult r;
@@ -41,7 +41,7 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
   screening::PipelineResult screened;
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    screened = screening_->process(r.frame, boxes, cam, depth);
+    screened = screening_->process(r.frame, boxes, cam, depth, detector_ran);
   }
   r.stats.screening_ms = sw.ms();
   r.boxes = std::move(screened.boxes);

@@ -35,7 +35,9 @@ class DetectorNodelet : public nodelet::Nodelet {
     if (enabled_) {
       try {
         const Config cfg = loadSettings(pnh);
-        if (detection::AsyncDetectionOptions::load(cfg).enabled) input_queue = 1;
+        bool async = detection::AsyncDetectionOptions::load(cfg).enabled;
+        pnh.param("async_detection", async, async);
+        if (async) input_queue = 1;
         detection::DetectorOptions opt = detection::DetectorOptions::load(cfg);
         if (!model.empty()) opt.model = model;
         double conf = -1;

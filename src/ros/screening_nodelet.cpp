@@ -63,7 +63,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
       if (!use_boxes_) sopt.tracker.enabled = false;
       front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
-      const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
+      detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
+      pnh.param("async_detection", aopt.enabled, aopt.enabled);
       async_boxes_ = use_boxes_ && aopt.enabled;
       box_feed_ = std::make_unique<detection::BoxFeed>(aopt.max_age_s);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
@@ -132,9 +133,11 @@ class ScreeningNodelet : public nodelet::Nodelet {
     newest_boxes_ = std::move(r);
   }
   // The boxes of a frame: synchronised ones, or the newest asynchronous result if fresh.
-  detection::Boxes boxesFor(const ::ros::Time& stamp, const BoundingBoxes::ConstPtr& synced) {
-    if (synced) return boxesFromMsg(synced->boxes);
-    if (!async_boxes_) return {};
+  detection::FrameBoxes boxesFor(const ::ros::Time& stamp, const BoundingBoxes::ConstPtr& synced) {
+    detection::FrameBoxes fixed;
+    fixed.fresh = true;  // synchronised boxes, or none at all: the detector's verdict on this frame
+    if (synced) fixed.boxes = boxesFromMsg(synced->boxes);
+    if (synced || !async_boxes_) return fixed;
     std::optional<detection::DetectionResult> newest;
     {
       std::lock_guard<std::mutex> lock(boxes_mutex_);
@@ -144,7 +147,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     detection::FrameBoxes fb = box_feed_->take(newest, stamp.toSec());
     boxes_too_old_ += box_feed_->expired() - expired_before;
     if (fb.fresh) ++frames_with_new_boxes_;
-    return std::move(fb.boxes);
+    return fb;
   }
   void onFrame3(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                 const BoundingBoxes::ConstPtr& boxes) {
@@ -186,9 +189,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
                     std::to_string(image.rows) + " differs from the calibration (" +
                     std::to_string(cam.width) + "x" + std::to_string(cam.height) + ")");
       cam.rgb_order = is_rgb;
-      const detection::Boxes boxes = boxesFor(rgb->header.stamp, boxes_msg);
+      const detection::FrameBoxes boxes = boxesFor(rgb->header.stamp, boxes_msg);
       const frontend::FrontEndResult fe =
-          front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes, cam);
+          front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes.boxes, cam, boxes.fresh);
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;

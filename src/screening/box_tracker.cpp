@@ -76,7 +76,7 @@ bool BoxTracker::displacement(const Track& t, const features::FeatureFrame& fram
 }
 
 detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
-                                     const detection::Boxes& detections) {
+                                     const detection::Boxes& detections, bool detector_ran) {
   detection::Boxes out = detections;
   for (auto& b : out) b.tracked = false;
   const size_t nd = detections.size();
@@ -116,7 +116,9 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
       kept.push_back(std::move(tr));
       continue;
     }
-    if (++tr.age > opt_.max_age || tr.box.score < opt_.min_score) continue;
+    // A weak track is dropped when the detector looked and did not find it again; a frame the
+    // detector never saw (asynchronous detection) carries every track.
+    if (++tr.age > opt_.max_age || (detector_ran && tr.box.score < opt_.min_score)) continue;
     cv::Point2f d;
     if (!displacement(tr, frame, d)) continue;
     cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);

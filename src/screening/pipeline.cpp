@@ -22,9 +22,9 @@ ScreeningPipeline::ScreeningPipeline(const ScreeningOptions& options) : screener
 
 PipelineResult ScreeningPipeline::process(features::FeatureFrame& frame,
                                           const detection::Boxes& detections,
-                                          const CameraModel& cam, const cv::Mat& depth_m) {
+                                          const CameraModel& cam, const cv::Mat& depth_m, bool detector_ran) {
   PipelineResult r;
-  r.boxes = box_tracker_ ? box_tracker_->predict(frame, detections) : detections;
+  r.boxes = box_tracker_ ? box_tracker_->predict(frame, detections, detector_ran) : detections;
   r.stats = screener_.screen(frame, r.boxes, depth_m);
   // The tracker remembers what screening found in its boxes, before propagation adds labels
   // that may lie outside them and the veto removes some.

@@ -91,13 +91,13 @@ cv::Mat usableDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
 }  // namespace
 
 TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                              const detection::Boxes& boxes) {
+                              const detection::Boxes& boxes, bool detector_ran) {
   std::call_once(front_end_once_, [this] {
     front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
   });
   frontend::FrontEndResult fe;
   try {
-    fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_);
+    fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_, detector_ran);
   } catch (const Error& e) {
     std::fprintf(stderr, "warning: frame %.6f: %s; frame reported lost\n", stamp, e.what());
     fe = frontend::FrontEndResult();

@@ -96,11 +96,11 @@ TEST(BoxFeed, AResultServesOneFrameAndExpires) {
 
 TEST(AsyncDetectionOptions, LoadsAndRejectsNegativeAge) {
   const AsyncDetectionOptions d = AsyncDetectionOptions::load(Config());
-  EXPECT_TRUE(d.enabled);
+  EXPECT_FALSE(d.enabled);
   EXPECT_DOUBLE_EQ(d.max_age_s, 0.2);
   const AsyncDetectionOptions o =
-      AsyncDetectionOptions::load(Config::fromString("Detection.async: 0\nDetection.maxAge: 0.5\n"));
-  EXPECT_FALSE(o.enabled);
+      AsyncDetectionOptions::load(Config::fromString("Detection.async: 1\nDetection.maxAge: 0.5\n"));
+  EXPECT_TRUE(o.enabled);
   EXPECT_DOUBLE_EQ(o.max_age_s, 0.5);
   EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.maxAge: -1\n", "bad.yaml")), Error);
 }

@@ -52,7 +52,7 @@ Detector.confThreshold: 0.375
 Detector.nmsThreshold: 0.5
 Detector.threads: 3
 Detector.dynamicClasses: [ "person" ]
-Detection.async: 0
+Detection.async: 1
 Detection.maxAge: 0.375
 Screening.mode: "detect"
 Screening.variant: "grow"
@@ -186,7 +186,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(320, 256, false, 0.375f, 0.5f, 3));
   EXPECT_EQ(d.dynamic_classes, std::vector<std::string>{"person"});
   const detection::AsyncDetectionOptions a = detection::AsyncDetectionOptions::load(cfg);
-  EXPECT_EQ(std::tie(a.enabled, a.max_age_s), std::make_tuple(false, 0.375));
+  EXPECT_EQ(std::tie(a.enabled, a.max_age_s), std::make_tuple(true, 0.375));
 
   const screening::ScreeningOptions& s = sys.screening;
   using screening::DynamicMode;

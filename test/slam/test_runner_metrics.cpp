@@ -318,7 +318,7 @@ TEST_F(RunnerMetrics, CtrlCWritesTheFramesDoneSoFar) {
 TEST_F(RunnerMetrics, CameraRateAndAsyncDetectionAccountForEveryFrame) {
   const std::string out = joinPath(dir_, "out_camera");
   std::string so, se;
-  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--camera-rate", "--max-frames", "20"},
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--camera-rate", "--detection", "async", "--max-frames", "20"},
                     joinPath(dir_, "camera"), so, se),
             0)
       << so << se;
@@ -329,7 +329,7 @@ TEST_F(RunnerMetrics, CameraRateAndAsyncDetectionAccountForEveryFrame) {
   EXPECT_GE(numberOf(cam, "processed"), 1) << cam.dump();
   EXPECT_EQ(numberOf(js, "frames"), numberOf(cam, "processed")) << js.dump();
   EXPECT_EQ(numberOf(js["timings"]["latency"], "count"), numberOf(cam, "processed")) << js.dump();
-  // The default detection is asynchronous: every processed frame was offered to the detector.
+  // Asynchronous detection: every processed frame was offered to the detector.
   const Json det = js["detection"];
   EXPECT_EQ(det["mode"], "async") << det.dump();
   EXPECT_EQ(numberOf(det, "offered"), numberOf(cam, "processed")) << det.dump();

@@ -68,7 +68,10 @@ class BoxTracker {
   // keypoints matched into `frame` and clipped to the image; such boxes have tracked = true.
   // Tracks without enough matches, past max_age or moved out of the image are dropped.
   // Detections not associated to a track start new tracks.
-  detection::Boxes predict(const features::FeatureFrame& frame, const detection::Boxes& detections);
+  // detector_ran false: the detector did not look at this frame (asynchronous detection
+  // between results): every track is carried, weak ones too, within max_age.
+  detection::Boxes predict(const features::FeatureFrame& frame, const detection::Boxes& detections,
+                           bool detector_ran = true);
 
   // After screening `frame` with the boxes of the last predict(): each track remembers the
   // keypoints flagged dynamic inside its box (positions + descriptors). A track with none left

@@ -44,8 +44,10 @@ class ScreeningPipeline {
   // Screens `frame` (sets frame.dynamic) with the detector's boxes of this frame; `cam` gives
   // the intrinsics for label propagation's camera-motion estimate; depth_m (CV_32F metres, may
   // be empty) the depth image for the silhouette rule.
+  // detector_ran false: `detections` is empty because the detector did not look at this frame
+  // (asynchronous detection), not because it found nobody.
   PipelineResult process(features::FeatureFrame& frame, const detection::Boxes& detections,
-                         const CameraModel& cam, const cv::Mat& depth_m = cv::Mat());
+                         const CameraModel& cam, const cv::Mat& depth_m = cv::Mat(), bool detector_ran = true);
   // Forgets tracked boxes and the previous frame (a new sequence or a map reset).
   void clear();
 

@@ -105,8 +105,10 @@ class System {
   // BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F metres (0/NaN invalid) or empty. Bad
   // input (empty image, wrong depth size/type) is reported on stderr and the frame is reported
   // lost; never throws for per-frame data problems.
+  // detector_ran false: `boxes` is empty because no detection was made for this frame
+  // (asynchronous detection), so the box tracker carries every box.
   TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                        const detection::Boxes& boxes);
+                        const detection::Boxes& boxes, bool detector_ran = true);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
   TrackResult trackFeatures(const features::FeatureFrame& frame);
 
