@@ -9,6 +9,12 @@
 namespace yolo_slam {
 namespace features {
 
+// Hamming distance bounds (of 256 bits) of an ORB descriptor match, ORB-SLAM2's ORBmatcher
+// TH_LOW (a confident match: BoW, triangulation, fusion, and frame-to-frame matching in
+// screening) and TH_HIGH (projection searches).
+constexpr int kOrbHammingLow = 50;
+constexpr int kOrbHammingHigh = 100;
+
 struct FeatureFrame {
   double stamp = 0.0;
   int width = 0, height = 0;                 // image size in pixels

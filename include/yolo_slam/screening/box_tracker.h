@@ -36,8 +36,8 @@ struct BoxTrackerOptions {
   // Pixel radius around a remembered keypoint's old position searched for its match: bounds
   // the person's image motion per frame (TUM walking at 30 Hz: tens of pixels).
   double radius_px = 40;
-  // A match needs at most this Hamming distance (of 256 bits); 50 is ORB-SLAM2's TH_LOW.
-  int max_hamming = 50;
+  // A match needs at most this Hamming distance (of 256 bits): ORB-SLAM2's TH_LOW.
+  int max_hamming = features::kOrbHammingLow;
   // Fewer matched keypoints than this: the person left the view or is hidden; drop the track
   // rather than trust a median of a handful of matches.
   int min_matches = 5;

@@ -47,8 +47,8 @@ struct TemporalOptions {
   // Pixel radius of the search around a keypoint's position in the previous frame (a walking
   // person moves tens of pixels per frame at 30 Hz).
   double radius_px = 30;
-  // A match needs at most this Hamming distance (of 256 bits); 50 is ORB-SLAM2's TH_LOW.
-  int max_hamming = 50;
+  // A match needs at most this Hamming distance (of 256 bits): ORB-SLAM2's TH_LOW.
+  int max_hamming = features::kOrbHammingLow;
   // When both keypoints have depth, they must differ by at most this (metres) to be one point.
   double max_depth_change_m = 0.2;
   // A match closer than this (pixels at pyramid level 0, times the level's scale) to the

@@ -14,10 +14,10 @@ class Map;
 
 namespace matcher {
 
-// Hamming distance bounds (of 256 bits) of a descriptor match: ORB-SLAM2 ORBmatcher TH_HIGH for
-// projection searches, TH_LOW for BoW, triangulation and fusion.
-constexpr int kThHigh = 100;
-constexpr int kThLow = 50;
+// Hamming distance bounds of a descriptor match: TH_HIGH for projection searches, TH_LOW for
+// BoW, triangulation and fusion.
+constexpr int kThHigh = features::kOrbHammingHigh;
+constexpr int kThLow = features::kOrbHammingLow;
 // searchProjections reports a map point as on a moving object only if the dynamic keypoint it
 // matches is within this fraction of the point's predicted depth (a nearer keypoint hides it).
 constexpr double kDynamicDepthTolerance = 0.1;

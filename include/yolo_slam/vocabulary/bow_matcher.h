@@ -5,6 +5,7 @@
 // match is kept if best <= th_low and best < nn_ratio * second. Optionally the matches are
 // filtered for rotation consistency (histogram of keypoint angle differences, 30 bins, keep
 // the three largest bins; a bin is dropped if below 10% of the largest).
+#include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/vocabulary/bow_vector.h"
 
 #include <opencv2/core.hpp>
@@ -16,7 +17,7 @@ namespace yolo_slam {
 namespace vocabulary {
 
 struct BowMatchOptions {
-  int th_low = 50;           // ORB-SLAM2 TH_LOW
+  int th_low = features::kOrbHammingLow;
   float nn_ratio = 0.7f;     // ORB-SLAM2 ratio in SearchByBoW
   bool check_orientation = true;
   int histogram_bins = 30;   // ORB-SLAM2 HISTO_LENGTH
