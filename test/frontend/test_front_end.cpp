@@ -2,6 +2,8 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/frontend/front_end.h"
 
+#include "support/images.h"
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -12,13 +14,7 @@ using namespace yolo_slam;
 
 namespace {
 
-cv::Mat texture(unsigned seed) {
-  cv::Mat img(480, 640, CV_8UC3);
-  cv::RNG rng(seed);
-  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(img, img, cv::Size(5, 5), 1.5);
-  return img;
-}
+cv::Mat texture(unsigned seed) { return test_support::texturedImage(seed); }
 
 // A wall 3 m away with a "person" 1.2 m away in the box region.
 const cv::Rect kPerson(260, 120, 120, 300);

@@ -11,18 +11,15 @@
 #include "yolo_slam/slam/system.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
+#include "support/loop_preset.h"
+
 #include <gtest/gtest.h>
 
 using namespace yolo_slam;
 
 TEST(SlamLoopClosing, LoopPresetDetectsLoopAndLowersAte) {
-  auto voc = vocabulary::Vocabulary::load(packageDir() + "/vocab/yolo_slam_orb_k10_L4.vocab");
-  sim::SynthOptions so;
-  so.preset = "loop";
-  so.fps = 5.0;
-  so.frames = 200;  // the preset's 40 s
-  so.seed = 2;
-  sim::SequenceGenerator gen(so);
+  auto voc = test_support::shippedVocabulary();
+  sim::SequenceGenerator gen(test_support::loopPreset());
 
   slam::SystemOptions opt = slam::SystemOptions::load(Config());
   opt.screening.mode = screening::DynamicMode::Off;

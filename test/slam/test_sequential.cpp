@@ -10,6 +10,8 @@
 #include "yolo_slam/slam/system.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
+#include "support/loop_preset.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -58,13 +60,8 @@ TEST(SlamSequential, SettingsKeyDefaultsToThreaded) {
 }
 
 TEST(SlamSequential, LoopPresetTwiceBitIdentical) {
-  auto voc = vocabulary::Vocabulary::load(packageDir() + "/vocab/yolo_slam_orb_k10_L4.vocab");
-  sim::SynthOptions so;
-  so.preset = "loop";
-  so.fps = 5.0;
-  so.frames = 200;  // the preset's 40 s
-  so.seed = 2;
-  sim::SequenceGenerator gen(so);
+  auto voc = test_support::shippedVocabulary();
+  sim::SequenceGenerator gen(test_support::loopPreset());
 
   const slam::SystemOptions opt = sequentialOptions();
   ASSERT_TRUE(opt.slam.loop.enabled && opt.slam.loop.global_ba);  // the defaults

@@ -5,6 +5,8 @@
 #include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/slam/system.h"
 
+#include "support/images.h"
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -24,13 +26,7 @@ SystemOptions offOptions() {
 }
 
 // A textured image (smoothed noise) and a plane 2 m away.
-cv::Mat texture(unsigned seed) {
-  cv::Mat img(480, 640, CV_8UC3);
-  cv::RNG rng(seed);
-  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(img, img, cv::Size(5, 5), 1.5);
-  return img;
-}
+cv::Mat texture(unsigned seed) { return test_support::texturedImage(seed); }
 
 void expectFinite(const Trajectory& t) {
   for (const auto& p : t) {
