@@ -15,6 +15,7 @@
 #   :notrack  no box tracking between detections (--track-boxes off)
 #   :veto / :noveto   static-box veto on / off (--static-box-veto)
 #   :prop / :noprop   label propagation on / off (--propagate-labels)
+#   :motion / :nomotion   motion screening on / off (--set Screening.motionScreening=1/0)
 #   :single   the main detection model alone, without Detector.extraModels (--single-model)
 #   :every / :async   detection on every frame before it is screened (the paper's pipeline,
 #             the measurements before 2026-12-01) / asynchronous detection (the default)
@@ -83,6 +84,8 @@ suffix_options() {
       noveto) extra+=(--static-box-veto off) ;;
       prop) extra+=(--propagate-labels on) ;;
       noprop) extra+=(--propagate-labels off) ;;
+      motion) extra+=(--set Screening.motionScreening=1) ;;
+      nomotion) extra+=(--set Screening.motionScreening=0) ;;
       single) extra+=(--single-model) ;;
       every) extra+=(--detection every-frame) ;;
       async) extra+=(--detection async) ;;
@@ -98,7 +101,7 @@ for m in $modes; do
     off|detect|geometry|detect+geometry) ;;
     *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
-  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :single :every :async :seq :camera" >&2; exit 1; }
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :motion :nomotion :single :every :async :seq :camera" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

@@ -615,6 +615,7 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res
   j["track_boxes"] = st.box_tracking;
   j["propagate_labels"] = st.label_propagation;
   j["static_box_veto"] = st.static_box_veto;
+  j["motion_screening"] = st.motion_screening;
   j["sequential"] = setup.options.sequential;
   j["vocabulary"] = args.vocabulary;
   j["screening_metrics"] = res.metrics.json();
@@ -653,8 +654,10 @@ void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary
   if (setup.stages.static_box_veto)
     std::printf("static-box veto: %d boxes left alone, %d screened keypoints kept\n", s.temporal.boxes_vetoed,
                 s.temporal.vetoed);
+  if (setup.stages.motion_screening)
+    std::printf("motion screening marked %d keypoints dynamic\n", s.temporal.motion_dropped);
   if (res.metrics.frames > 0)
-    std::printf("dynamic keypoints outside every box: %s dropped\n",
+    std::printf("dynamic keypoints outside every box: %ld, %s dropped\n", static_cast<long>(m.dynamic_outside_boxes),
                 percent(m.dynamic_outside_dropped, m.dynamic_outside_boxes).c_str());
 }
 

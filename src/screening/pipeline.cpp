@@ -10,6 +10,7 @@ Stages stagesFor(const ScreeningOptions& o) {
   const bool screens = o.mode != DynamicMode::Off;
   s.label_propagation = screens && o.temporal.propagate_labels;
   s.static_box_veto = screens && o.temporal.static_box_veto;
+  s.motion_screening = screens && o.temporal.motion_screening;
   return s;
 }
 

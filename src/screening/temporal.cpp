@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace yolo_slam {
 namespace screening {
@@ -19,6 +20,11 @@ namespace {
 constexpr int kMaxMotionPairs = 300;
 constexpr int kMinMotionInliers = 15;
 constexpr double kPnpReprojectionPx = 2.0;
+// Flow of a point that the camera motion puts behind the camera: moved, and like no other.
+constexpr float kBehindCamera = 1e6f;
+// Moved neighbours support a keypoint when their flows differ by at most this share of its flow
+// (or motionFlowTolerance pixels if more): limbs and torso of one walker move alike enough.
+constexpr double kFlowRelativeTolerance = 0.5;
 
 const std::vector<cv::KeyPoint>& undistorted(const features::FeatureFrame& f) {
   return f.keypoints_un.size() == f.keypoints.size() ? f.keypoints_un : f.keypoints;
@@ -30,6 +36,12 @@ bool isDynamic(const features::FeatureFrame& f, size_t i) {
 
 float depthOf(const features::FeatureFrame& f, size_t i) {
   return i < f.depth.size() ? f.depth[i] : 0.f;
+}
+
+// Keypoints of coarser pyramid levels are located less precisely: distances are measured in
+// units of the level's scale (the keypoint's size is the patch diameter times the scale).
+double levelScale(const cv::KeyPoint& kp) {
+  return std::max(1.0, kp.size / double(features::OrbExtractor::kPatchSize));
 }
 
 const OptionTable<TemporalOptions>& temporalFields() {
@@ -45,6 +57,13 @@ const OptionTable<TemporalOptions>& temporalFields() {
       {"Screening.temporalMaxHamming", &O::max_hamming, Range::closed(0, 256)},
       {"Screening.temporalMaxDepthChange", &O::max_depth_change_m, Range::positive()},
       {"Screening.temporalStaticTolerance", &O::static_tolerance_px, Range::atLeast(0)},
+      {"Screening.motionScreening", &O::motion_screening},
+      {"Screening.motionMinResidual", &O::motion_min_residual_px, Range::atLeast(0)},
+      {"Screening.motionSupportRadius", &O::motion_support_radius_px, Range::positive()},
+      {"Screening.motionMinSupport", &O::motion_min_support, Range::atLeast(0)},
+      {"Screening.motionMinShare", &O::motion_min_share, Range::fraction()},
+      {"Screening.motionSupportDepth", &O::motion_support_depth_m, Range::positive()},
+      {"Screening.motionFlowTolerance", &O::motion_flow_tolerance_px, Range::positive()},
   };
   return table;
 }
@@ -114,99 +133,163 @@ bool TemporalScreening::solveMotion(const std::vector<cv::Point3f>& obj,
   return std::isfinite(cv::norm(R)) && std::isfinite(cv::norm(t));
 }
 
-TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const detection::Boxes& boxes,
-                                       const CameraModel& cam) {
-  TemporalStats st;
+std::vector<int> TemporalScreening::matchPrevious(const features::FeatureFrame& frame, TemporalStats& st) const {
   const size_t n = frame.size();
-  frame.dynamic.resize(n, 0);
-  std::vector<int> age(n, 0), match(n, -1);
-  const bool usable = frame.descriptors.rows == static_cast<int>(n) && !prev_.keypoints.empty();
-  if (usable) {
-    const features::KeypointIndex index(prev_, opt_.radius_px);
-    for (size_t i = 0; i < n; ++i) {
-      const int j = index.bestMatchNear(frame.keypoints[i].pt,
-                                        frame.descriptors.ptr<uint8_t>(static_cast<int>(i)),
-                                        opt_.radius_px, opt_.max_hamming);
-      if (j < 0) continue;
-      const float d = depthOf(frame, i), dp = prev_X_[j].z;
-      if (d > 0 && dp > 0 && std::fabs(d - dp) > opt_.max_depth_change_m) continue;
-      match[i] = j;
-      ++st.matched;
-    }
+  std::vector<int> match(n, -1);
+  if (frame.descriptors.rows != static_cast<int>(n) || prev_.keypoints.empty()) return match;
+  const features::KeypointIndex index(prev_, opt_.radius_px);
+  for (size_t i = 0; i < n; ++i) {
+    const int j = index.bestMatchNear(frame.keypoints[i].pt, frame.descriptors.ptr<uint8_t>(static_cast<int>(i)),
+                                      opt_.radius_px, opt_.max_hamming);
+    if (j < 0) continue;
+    const float d = depthOf(frame, i), dp = prev_X_[j].z;
+    if (d > 0 && dp > 0 && std::fabs(d - dp) > opt_.max_depth_change_m) continue;
+    match[i] = j;
+    ++st.matched;
   }
-  cv::Matx33d R;
-  cv::Vec3d t;
-  const bool motion_ok = usable && estimateMotion(frame, match, cam, R, t, st.motion_inliers);
-  st.motion_frames = motion_ok ? 1 : 0;
-  // Per keypoint: -1 untested (no match, or no depth in the previous frame: the point's static
-  // position is unknown), 0 moved, 1 static-consistent.
+  return match;
+}
+
+std::vector<int8_t> TemporalScreening::motionVerdicts(const features::FeatureFrame& frame,
+                                                      const std::vector<int>& match, const CameraModel& cam,
+                                                      const cv::Matx33d& R, const cv::Vec3d& t,
+                                                      std::vector<cv::Point2f>& flow, TemporalStats& st) const {
+  const size_t n = frame.size();
   std::vector<int8_t> verdict(n, -1);
-  if (motion_ok) {
-    const auto& kun = undistorted(frame);
+  flow.assign(n, cv::Point2f(0, 0));
+  const auto& kun = undistorted(frame);
+  for (size_t i = 0; i < n; ++i) {
+    const int j = match[i];
+    if (j < 0 || prev_X_[j].z <= 0) continue;
+    const cv::Vec3d Y = R * cv::Vec3d(prev_X_[j].x, prev_X_[j].y, prev_X_[j].z) + t;
+    bool consistent = false;
+    if (Y[2] > 0) {
+      flow[i] = kun[i].pt - cv::Point2f(static_cast<float>(cam.fx * Y[0] / Y[2] + cam.cx),
+                                        static_cast<float>(cam.fy * Y[1] / Y[2] + cam.cy));
+      consistent = cv::norm(flow[i]) <= opt_.static_tolerance_px * levelScale(frame.keypoints[i]);
+    } else {
+      flow[i] = cv::Point2f(kBehindCamera, kBehindCamera);
+    }
+    verdict[i] = consistent ? 1 : 0;
+    st.static_consistent += consistent ? 1 : 0;
+  }
+  return verdict;
+}
+
+void TemporalScreening::vetoStaticBoxes(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                                        const std::vector<int8_t>& verdict, TemporalStats& st) const {
+  const size_t n = frame.size();
+  std::vector<cv::Rect2f> regions;
+  for (const auto& b : boxes) regions.push_back(dilate(b.rect, box_dilation_));
+  std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
+  for (size_t b = 0; b < regions.size(); ++b) {
+    if (boxes[b].score >= opt_.static_box_max_score) continue;
+    int tested = 0, consistent = 0;
     for (size_t i = 0; i < n; ++i) {
-      const int j = match[i];
-      if (j < 0 || prev_X_[j].z <= 0) continue;
-      const cv::Vec3d Y = R * cv::Vec3d(prev_X_[j].x, prev_X_[j].y, prev_X_[j].z) + t;
-      bool consistent = false;
-      if (Y[2] > 0) {
-        const double du = cam.fx * Y[0] / Y[2] + cam.cx - kun[i].pt.x;
-        const double dv = cam.fy * Y[1] / Y[2] + cam.cy - kun[i].pt.y;
-        // Keypoints of coarser pyramid levels are located less precisely: the tolerance grows
-        // with the level's scale (the keypoint's size is the patch diameter times the scale).
-        const double scale =
-            std::max(1.0, frame.keypoints[i].size / double(features::OrbExtractor::kPatchSize));
-        const double tol = opt_.static_tolerance_px * scale;
-        consistent = du * du + dv * dv <= tol * tol;
-      }
-      verdict[i] = consistent ? 1 : 0;
-      st.static_consistent += consistent ? 1 : 0;
+      if (!frame.dynamic[i] || verdict[i] < 0 || !inside(regions[b], frame.keypoints[i].pt)) continue;
+      ++tested;
+      consistent += verdict[i];
+    }
+    if (tested >= opt_.static_box_min_points && consistent >= opt_.static_box_fraction * tested) {
+      keep_box[b] = 0;
+      ++st.boxes_vetoed;
     }
   }
-  if (motion_ok && opt_.static_box_veto) {
-    std::vector<cv::Rect2f> regions;
-    for (const auto& b : boxes) regions.push_back(dilate(b.rect, box_dilation_));
-    std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
+  if (st.boxes_vetoed == 0) return;
+  for (size_t i = 0; i < n; ++i) {
+    if (!frame.dynamic[i]) continue;
+    bool in_vetoed = false, in_standing = false;
     for (size_t b = 0; b < regions.size(); ++b) {
-      if (boxes[b].score >= opt_.static_box_max_score) continue;
-      int tested = 0, consistent = 0;
-      for (size_t i = 0; i < n; ++i) {
-        if (!frame.dynamic[i] || verdict[i] < 0 || !inside(regions[b], frame.keypoints[i].pt)) continue;
-        ++tested;
-        consistent += verdict[i];
-      }
-      if (tested >= opt_.static_box_min_points && consistent >= opt_.static_box_fraction * tested) {
-        keep_box[b] = 0;
-        ++st.boxes_vetoed;
-      }
+      if (!inside(regions[b], frame.keypoints[i].pt)) continue;
+      (keep_box[b] ? in_standing : in_vetoed) = true;
     }
-    if (st.boxes_vetoed > 0) {
-      for (size_t i = 0; i < n; ++i) {
-        if (!frame.dynamic[i]) continue;
-        bool in_vetoed = false, in_standing = false;
-        for (size_t b = 0; b < regions.size(); ++b) {
-          if (!inside(regions[b], frame.keypoints[i].pt)) continue;
-          (keep_box[b] ? in_standing : in_vetoed) = true;
-        }
-        // A keypoint also inside a box whose verdict stands (overlapping people) stays dropped.
-        if (in_vetoed && !in_standing) {
-          frame.dynamic[i] = 0;
-          ++st.vetoed;
-        }
-      }
+    // A keypoint also inside a box whose verdict stands (overlapping people) stays dropped.
+    if (in_vetoed && !in_standing) {
+      frame.dynamic[i] = 0;
+      ++st.vetoed;
     }
   }
-  if (motion_ok && opt_.propagate_labels) {
-    for (size_t i = 0; i < n; ++i) {
-      const int j = match[i];
-      if (verdict[i] != 0 || frame.dynamic[i] || !isDynamic(prev_, j) || prev_age_[j] >= opt_.propagate_max_age)
-        continue;
-      frame.dynamic[i] = 1;
-      age[i] = prev_age_[j] + 1;
-      ++st.propagated;
-    }
+}
+
+features::FeatureFrame TemporalScreening::staticPositions(const CameraModel& cam, const cv::Matx33d& R,
+                                                          const cv::Vec3d& t) const {
+  features::FeatureFrame f;
+  std::vector<int> rows;
+  for (size_t j = 0; j < prev_X_.size(); ++j) {
+    if (prev_X_[j].z <= 0) continue;
+    const cv::Vec3d Y = R * cv::Vec3d(prev_X_[j].x, prev_X_[j].y, prev_X_[j].z) + t;
+    if (Y[2] <= 0) continue;
+    cv::KeyPoint kp = prev_.keypoints[j];
+    kp.pt = cv::Point2f(static_cast<float>(cam.fx * Y[0] / Y[2] + cam.cx), static_cast<float>(cam.fy * Y[1] / Y[2] + cam.cy));
+    f.keypoints.push_back(kp);
+    rows.push_back(static_cast<int>(j));
   }
-  frame.motion = verdict;
-  // This frame becomes the previous one.
+  f.descriptors.create(static_cast<int>(rows.size()), prev_.descriptors.cols, prev_.descriptors.type());
+  for (size_t k = 0; k < rows.size(); ++k) prev_.descriptors.row(rows[k]).copyTo(f.descriptors.row(static_cast<int>(k)));
+  return f;
+}
+
+void TemporalScreening::screenMotion(features::FeatureFrame& frame, const std::vector<int8_t>& verdict,
+                                     const std::vector<cv::Point2f>& flow, const CameraModel& cam,
+                                     const cv::Matx33d& R, const cv::Vec3d& t, TemporalStats& st) const {
+  const size_t n = frame.size();
+  // A keypoint that matched a moving twin but also looks like a point of the previous frame that
+  // the camera motion brings to where it is, is static: repeated texture (windows, tiles) makes
+  // such twins, and the nearest descriptor is not always the right one.
+  const features::FeatureFrame statics = staticPositions(cam, R, t);
+  const features::KeypointIndex twins(statics, opt_.radius_px);
+  const auto& kun = undistorted(frame);
+  std::vector<size_t> tested;
+  std::vector<uint8_t> moved(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (verdict[i] < 0) continue;
+    tested.push_back(i);
+    const double scale = levelScale(frame.keypoints[i]);
+    moved[i] = verdict[i] == 0 && cv::norm(flow[i]) >= opt_.motion_min_residual_px * scale &&
+               twins.bestMatchNear(kun[i].pt, frame.descriptors.ptr<uint8_t>(static_cast<int>(i)),
+                                   opt_.motion_min_residual_px * scale, opt_.max_hamming) < 0;
+  }
+  const float r2 = static_cast<float>(opt_.motion_support_radius_px * opt_.motion_support_radius_px);
+  std::vector<size_t> marked;
+  for (size_t i : tested) {
+    if (!moved[i] || frame.dynamic[i]) continue;
+    const cv::Point2f p = frame.keypoints[i].pt;
+    const float zi = depthOf(frame, i);
+    // A moving body moves its keypoints alike; false matches in the static scene scatter.
+    const double flow_tol = std::max(opt_.motion_flow_tolerance_px, kFlowRelativeTolerance * cv::norm(flow[i]));
+    int near_tested = 0, near_moved = 0;
+    for (size_t k : tested) {
+      if (k == i) continue;
+      const cv::Point2f d = frame.keypoints[k].pt - p;
+      if (d.dot(d) > r2) continue;
+      const float zk = depthOf(frame, k);
+      if (zi > 0 && zk > 0 && std::fabs(zi - zk) > opt_.motion_support_depth_m) continue;
+      ++near_tested;
+      near_moved += moved[k] && cv::norm(flow[k] - flow[i]) <= flow_tol ? 1 : 0;
+    }
+    if (near_moved >= opt_.motion_min_support && near_moved >= opt_.motion_min_share * near_tested)
+      marked.push_back(i);
+  }
+  // Marked after the scan, so that the verdict of one keypoint never depends on the order.
+  for (size_t i : marked) frame.dynamic[i] = 1;
+  st.motion_dropped += static_cast<int>(marked.size());
+}
+
+void TemporalScreening::propagate(features::FeatureFrame& frame, const std::vector<int>& match,
+                                  const std::vector<int8_t>& verdict, std::vector<int>& age,
+                                  TemporalStats& st) const {
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const int j = match[i];
+    if (verdict[i] != 0 || frame.dynamic[i] || !isDynamic(prev_, j) || prev_age_[j] >= opt_.propagate_max_age)
+      continue;
+    frame.dynamic[i] = 1;
+    age[i] = prev_age_[j] + 1;
+    ++st.propagated;
+  }
+}
+
+void TemporalScreening::remember(const features::FeatureFrame& frame, const CameraModel& cam, std::vector<int> age) {
+  const size_t n = frame.size();
   prev_.keypoints = frame.keypoints;
   prev_.descriptors = frame.descriptors.clone();
   prev_.dynamic = frame.dynamic;
@@ -219,6 +302,29 @@ TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const dete
                                static_cast<float>((kun[i].pt.y - cam.cy) / cam.fy * z), z);
   }
   prev_age_ = std::move(age);
+}
+
+TemporalStats TemporalScreening::apply(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                                       const CameraModel& cam) {
+  TemporalStats st;
+  const size_t n = frame.size();
+  frame.dynamic.resize(n, 0);
+  std::vector<int> age(n, 0);
+  const std::vector<int> match = matchPrevious(frame, st);
+  cv::Matx33d R;
+  cv::Vec3d t;
+  const bool motion_ok = st.matched > 0 && estimateMotion(frame, match, cam, R, t, st.motion_inliers);
+  st.motion_frames = motion_ok ? 1 : 0;
+  std::vector<int8_t> verdict(n, -1);
+  if (motion_ok) {
+    std::vector<cv::Point2f> flow;
+    verdict = motionVerdicts(frame, match, cam, R, t, flow, st);
+    if (opt_.static_box_veto) vetoStaticBoxes(frame, boxes, verdict, st);
+    if (opt_.motion_screening) screenMotion(frame, verdict, flow, cam, R, t, st);
+    if (opt_.propagate_labels) propagate(frame, match, verdict, age, st);
+  }
+  frame.motion = verdict;
+  remember(frame, cam, std::move(age));
   return st;
 }
 
@@ -236,6 +342,7 @@ TemporalStats& TemporalStats::operator+=(const TemporalStats& o) {
   propagated += o.propagated;
   boxes_vetoed += o.boxes_vetoed;
   vetoed += o.vetoed;
+  motion_dropped += o.motion_dropped;
   return *this;
 }
 
@@ -243,7 +350,7 @@ void to_json(Json& j, const TemporalStats& s) {
   j = Json{{"matched", s.matched},           {"static_consistent", s.static_consistent},
            {"motion_frames", s.motion_frames}, {"motion_inliers", s.motion_inliers},
            {"propagated", s.propagated},     {"boxes_vetoed", s.boxes_vetoed},
-           {"vetoed", s.vetoed}};
+           {"vetoed", s.vetoed},             {"motion_dropped", s.motion_dropped}};
 }
 
 }  // namespace screening

@@ -31,9 +31,9 @@ struct World {
   std::vector<Point> points;
 };
 
-// Wall points spread over the view at 3 m; person points in a 0.5 x 1.2 m patch at 1.5 m
-// centred at (person_x, 0).
-World makeWorld(int n_wall, int n_person, double person_x, unsigned seed) {
+// Wall points spread over the view at 3 m (to 3 + 2 wall_relief); person points in a 0.5 x 1.2 m
+// patch at 1.5 m centred at (person_x, 0).
+World makeWorld(int n_wall, int n_person, double person_x, unsigned seed, double wall_relief = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   cv::RNG cvrng(seed);
@@ -46,7 +46,7 @@ World makeWorld(int n_wall, int n_person, double person_x, unsigned seed) {
     cvrng.fill(p.desc, cv::RNG::UNIFORM, 0, 256);
     w.points.push_back(p);
   };
-  for (int i = 0; i < n_wall; ++i) add({1.6 * u(rng), 1.2 * u(rng), 3.0}, false);
+  for (int i = 0; i < n_wall; ++i) add({1.6 * u(rng), 1.2 * u(rng), 3.0 + wall_relief * (1 + u(rng))}, false);
   for (int i = 0; i < n_person; ++i) add({person_x + 0.25 * u(rng), 0.6 * u(rng), 1.5}, true);
   return w;
 }
@@ -234,6 +234,100 @@ TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
   EXPECT_EQ(countDynamic(v.f1, v.w, false), wall_dropped);
 }
 
+TemporalOptions motionOnly() {
+  TemporalOptions o;
+  o.static_box_veto = false;
+  o.motion_screening = true;
+  return o;
+}
+
+TEST(Temporal, MotionScreeningDropsAnUndetectedWalkerButNotTheMovingCamerasStaticScene) {
+  // A room with depth: two fronto-parallel layers moving sideways are explained by one camera
+  // motion (a turn plus a larger shift), so a flat wall would hide the walker's motion.
+  const World w = makeWorld(400, 60, 0.3, 11, 1.5);
+  TemporalScreening ts(motionOnly(), kBoxDilation);
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, false);
+  ASSERT_EQ(f0.size(), w.points.size());
+  ts.apply(f0, {}, camera());
+  // No box in either frame; the camera moved 2 cm and the person 5 cm (~18 px at 1.5 m).
+  features::FeatureFrame f1 = render(w, 0.02, 0.05, false);
+  ASSERT_EQ(f1.size(), w.points.size());
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  ASSERT_TRUE(st.motionOk());
+  // Most: a walker's keypoint with fewer than motionMinSupport neighbours within
+  // motionSupportRadius stays (this walker's 60 points are sparse: about 4 in that radius).
+  EXPECT_GE(countDynamic(f1, w, true), 40);
+  EXPECT_EQ(st.motion_dropped, countDynamic(f1, w, true));
+  EXPECT_EQ(countDynamic(f1, w, false), 0);
+}
+
+TEST(Temporal, MotionScreeningNeedsMovedNeighboursThatMoveAlike) {
+  // Three isolated points of the wall "move" (a false match would look like this): each has no
+  // moved neighbour, so none is dropped; nor are slow movers below motionMinResidual.
+  World w = makeWorld(200, 0, 0, 12);
+  TemporalScreening ts(motionOnly(), kBoxDilation);
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, false);
+  ts.apply(f0, {}, camera());
+  features::FeatureFrame f1 = render(w, 0.02, 0.0, false);
+  const float shifts[3][2] = {{15, 0}, {0, -14}, {-12, 9}};
+  const cv::Point2f at[3] = {{100, 100}, {320, 240}, {540, 380}};
+  for (int k = 0; k < 3; ++k) {
+    // The keypoint nearest to `at` jumps by `shift`.
+    size_t best = 0;
+    for (size_t i = 1; i < f1.size(); ++i)
+      if (cv::norm(f1.keypoints[i].pt - at[k]) < cv::norm(f1.keypoints[best].pt - at[k])) best = i;
+    f1.keypoints[best].pt += cv::Point2f(shifts[k][0], shifts[k][1]);
+    f1.keypoints_un[best].pt = f1.keypoints[best].pt;
+  }
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  ASSERT_TRUE(st.motionOk());
+  EXPECT_EQ(st.matched, 200);
+  EXPECT_EQ(st.motion_dropped, 0);
+  EXPECT_EQ(f1.countDynamic(), 0u);
+
+  // A person creeping 1 cm per frame (~3.6 px at 1.5 m) is below the residual bound.
+  const World slow = makeWorld(400, 60, 0.3, 13, 1.5);
+  TemporalScreening ts2(motionOnly(), kBoxDilation);
+  features::FeatureFrame g0 = render(slow, 0.0, 0.0, false);
+  ts2.apply(g0, {}, camera());
+  features::FeatureFrame g1 = render(slow, 0.0, 0.01, false);
+  EXPECT_EQ(ts2.apply(g1, {}, camera()).motion_dropped, 0);
+}
+
+TEST(Temporal, MotionScreeningKeepsAKeypointWithAStaticTwin) {
+  // Repeated texture on a still patch (the "person" points, not moving here): in the previous
+  // frame every patch point has a twin 16 px to its right whose descriptor matches better than
+  // its own (a few bits differ). The nearest-descriptor match picks the twin, so the patch seems
+  // to move coherently by 16 px; the point's own, slightly worse lookalike at its static
+  // position tells it is static.
+  const World w = makeWorld(400, 60, 0.3, 14, 1.5);
+  TemporalScreening ts(motionOnly(), kBoxDilation);
+  features::FeatureFrame f0 = render(w, 0.0, 0.0, false);
+  features::FeatureFrame f1 = render(w, 0.0, 0.0, false);
+  ASSERT_EQ(f0.size(), w.points.size());
+  cv::Mat twins;
+  for (size_t i = 0; i < w.points.size(); ++i) {
+    if (!w.points[i].person) continue;
+    cv::KeyPoint twin = f0.keypoints[i];
+    twin.pt.x += 16;
+    f0.keypoints.push_back(twin);
+    f0.keypoints_un.push_back(twin);
+    f0.depth.push_back(f0.depth[i]);
+    f0.right_u.push_back(-1.f);
+    f0.dynamic.push_back(0);
+    twins.push_back(f0.descriptors.row(static_cast<int>(i)).clone());
+    f0.descriptors.at<uint8_t>(static_cast<int>(i), 0) ^= 0x0F;  // 4 bits off: still a lookalike
+  }
+  cv::vconcat(f0.descriptors, twins, f0.descriptors);
+  ts.apply(f0, {}, camera());
+  const TemporalStats st = ts.apply(f1, {}, camera());
+  ASSERT_TRUE(st.motionOk());
+  EXPECT_EQ(st.matched, 460);
+  EXPECT_LE(st.static_consistent, 400);  // the patch matched its twins: "moved"
+  EXPECT_EQ(st.motion_dropped, 0);
+  EXPECT_EQ(f1.countDynamic(), 0u);
+}
+
 TEST(Temporal, NothingChangesWithoutACameraMotionEstimate) {
   // Too few static keypoints with depth: the motion is unknown, so no label can be judged.
   const World w = makeWorld(8, 60, 0.0, 6);
@@ -263,13 +357,15 @@ TEST(Temporal, OptionsComeFromScreeningKeysAndBadValuesNameTheKey) {
   const Config cfg = Config::fromString(
       "%YAML:1.0\nScreening.propagateLabels: 1\nScreening.propagateMaxAge: 5\n"
       "Screening.staticBoxVeto: 0\nScreening.staticBoxFraction: 0.7\n"
-      "Screening.temporalStaticTolerance: 4\n");
+      "Screening.temporalStaticTolerance: 4\nScreening.motionScreening: 1\nScreening.motionMinSupport: 5\n");
   const TemporalOptions o = screening::ScreeningOptions::load(cfg).temporal;
   EXPECT_TRUE(o.propagate_labels);
   EXPECT_EQ(o.propagate_max_age, 5);
   EXPECT_FALSE(o.static_box_veto);
   EXPECT_DOUBLE_EQ(o.static_box_fraction, 0.7);
   EXPECT_DOUBLE_EQ(o.static_tolerance_px, 4.0);
+  EXPECT_TRUE(o.motion_screening);
+  EXPECT_EQ(o.motion_min_support, 5);
   try {
     screening::ScreeningOptions::load(
         Config::fromString("%YAML:1.0\nScreening.staticBoxFraction: 1.5\n"));

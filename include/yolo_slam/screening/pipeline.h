@@ -1,8 +1,8 @@
 #pragma once
 // Everything screening does to one frame of a camera stream, in order: carry person boxes over
 // frames the detector misses (BoxTracker, Screening.trackBoxes), Algorithm 1 in every box
-// (Screener), then the frame-to-frame evidence (TemporalScreening: static-box veto, label
-// propagation; Screening.staticBoxVeto, Screening.propagateLabels). Used by
+// (Screener), then the frame-to-frame evidence (TemporalScreening: static-box veto, motion
+// screening, label propagation; Screening.staticBoxVeto, motionScreening, propagateLabels). Used by
 // slam::System::trackRgbd and the ROS Screening nodelet, so the offline runner and the nodelet
 // graph screen identically.
 #include "yolo_slam/common/camera.h"
@@ -24,7 +24,8 @@ struct Stages {
   bool box_tracking = false;       // Screening.trackBoxes, in a mode with boxes
   bool label_propagation = false;  // Screening.propagateLabels, in every mode but off
   bool static_box_veto = false;    // Screening.staticBoxVeto, in every mode but off
-  bool temporal() const { return label_propagation || static_box_veto; }
+  bool motion_screening = false;   // Screening.motionScreening, in every mode but off
+  bool temporal() const { return label_propagation || static_box_veto || motion_screening; }
 };
 Stages stagesFor(const ScreeningOptions& options);
 

@@ -19,6 +19,13 @@
 //   (sitting_static 4.9 -> 53 mm without the score bound); but the detector is sure of them
 //   (scores 0.97-1.0 there) and unsure of its false positives (static_xyz: 95 % below 0.8).
 //
+// - Motion screening (Screening.motionScreening): class-agnostic. A keypoint that MOVED by at
+//   least motionMinResidual pixels against the camera motion, with at least motionMinSupport
+//   moved neighbours within motionSupportRadius at a similar depth that are the majority
+//   (motionMinShare) of the tested keypoints there, is dynamic, box or no box: people the
+//   detector missed or cut, and the things they carry. The support rule keeps isolated false
+//   matches in the static scene from being dropped.
+//
 // Per frame, after Screener::screen:  temporal.apply(frame, boxes, cam);
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/json.h"
@@ -55,11 +62,24 @@ struct TemporalOptions {
   // position predicted for a static point is static.
   double static_tolerance_px = 3;
 
-  bool enabled() const { return propagate_labels || static_box_veto; }
+  bool motion_screening = false;
+  // A moved keypoint counts only this far (pixels at level 0, times the level's scale) from
+  // its static position: twice the static tolerance, so that the band between stays untested.
+  double motion_min_residual_px = 6;
+  double motion_support_radius_px = 40;
+  int motion_min_support = 3;          // other moved keypoints within the radius
+  double motion_min_share = 0.5;       // moved share of the tested keypoints within the radius
+  double motion_support_depth_m = 0.3; // neighbours count when their depth differs by at most this
+  // Moved neighbours support a keypoint when their flows (pixels away from the static position)
+  // differ by at most this or half its flow, whichever is more.
+  double motion_flow_tolerance_px = 4;
+
+  bool enabled() const { return propagate_labels || static_box_veto || motion_screening; }
   // Reads Screening.propagateLabels, propagateMaxAge, staticBoxVeto, staticBoxFraction,
   // staticBoxMinPoints, staticBoxMaxScore, temporalRadius (px), temporalMaxHamming (bits),
-  // temporalMaxDepthChange (m), temporalStaticTolerance (px); throws yolo_slam::Error naming
-  // the file and key.
+  // temporalMaxDepthChange (m), temporalStaticTolerance (px), motionScreening,
+  // motionMinResidual (px), motionSupportRadius (px), motionMinSupport, motionMinShare,
+  // motionSupportDepth (m), motionFlowTolerance (px); throws yolo_slam::Error naming the file and key.
   static TemporalOptions load(const Config& cfg);
   // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "TemporalOptions") const;
@@ -74,11 +94,12 @@ struct TemporalStats {
   int propagated = 0;           // keypoints marked dynamic by label propagation
   int boxes_vetoed = 0;         // boxes left alone by the static-box veto
   int vetoed = 0;               // screened-dynamic keypoints they kept
+  int motion_dropped = 0;       // keypoints marked dynamic by motion screening
   bool motionOk() const { return motion_frames > 0; }  // of one frame's stats
   TemporalStats& operator+=(const TemporalStats& o);
 };
 // {"matched", "static_consistent", "motion_frames", "motion_inliers", "propagated",
-//  "boxes_vetoed", "vetoed"}
+//  "boxes_vetoed", "vetoed", "motion_dropped"}
 void to_json(Json& j, const TemporalStats& s);
 
 // One per camera stream; deterministic. Not thread-safe: the caller serialises frames.
@@ -89,13 +110,32 @@ class TemporalScreening {
   TemporalScreening(const TemporalOptions& options, double box_dilation);
   const TemporalOptions& options() const { return opt_; }
 
-  // After Screener::screen on `frame` with `boxes`: the static-box veto, then label
-  // propagation, then `frame` becomes the previous frame of the next call.
+  // After Screener::screen on `frame` with `boxes`: the static-box veto, motion screening,
+  // label propagation, then `frame` becomes the previous frame of the next call.
   TemporalStats apply(features::FeatureFrame& frame, const detection::Boxes& boxes,
                       const CameraModel& cam);
   void clear();
 
  private:
+  // apply()'s phases. Matches of the current keypoints in the previous frame (-1: none).
+  std::vector<int> matchPrevious(const features::FeatureFrame& frame, TemporalStats& st) const;
+  // Per keypoint: -1 untested, 0 moved, 1 static-consistent; `flow` where it is minus where a
+  // static point would be (pixels).
+  std::vector<int8_t> motionVerdicts(const features::FeatureFrame& frame, const std::vector<int>& match,
+                                     const CameraModel& cam, const cv::Matx33d& R, const cv::Vec3d& t,
+                                     std::vector<cv::Point2f>& flow, TemporalStats& st) const;
+  void vetoStaticBoxes(features::FeatureFrame& frame, const detection::Boxes& boxes,
+                       const std::vector<int8_t>& verdict, TemporalStats& st) const;
+  void screenMotion(features::FeatureFrame& frame, const std::vector<int8_t>& verdict,
+                    const std::vector<cv::Point2f>& flow, const CameraModel& cam, const cv::Matx33d& R,
+                    const cv::Vec3d& t, TemporalStats& st) const;
+  // The previous frame's keypoints with depth where the camera motion puts them in the current
+  // (undistorted) image, with their descriptors.
+  features::FeatureFrame staticPositions(const CameraModel& cam, const cv::Matx33d& R, const cv::Vec3d& t) const;
+  void propagate(features::FeatureFrame& frame, const std::vector<int>& match,
+                 const std::vector<int8_t>& verdict, std::vector<int>& age, TemporalStats& st) const;
+  void remember(const features::FeatureFrame& frame, const CameraModel& cam, std::vector<int> age);
+
   // Camera motion from the previous frame to the current one (X_cur = R X_prev + t) from the
   // matched pairs whose both ends are static; false when too few agree.
   bool estimateMotion(const features::FeatureFrame& frame, const std::vector<int>& match,
