@@ -10,6 +10,9 @@ namespace sim {
 namespace {
 
 constexpr double kNear = 0.05;  // metres: geometry nearer than this is clipped
+// Brightest detail texel relative to its crop's mean: bright specks in a dark crop would
+// otherwise turn parts of a person white.
+constexpr float kMaxDetailRatio = 2.f;
 
 // A quad transformed into the camera frame, with the plane facing the camera (h < 0).
 struct Setup {
@@ -151,7 +154,7 @@ void drawQuad(const DrawContext& c, const Quad& q, const Setup& s) {
           mipSample(*detail, detail_tpm, z_plane * ifx, cosang, (float)(dt.tex_rect.x + a * dt.tex_rect.width),
                     (float)(dt.tex_rect.y + (1 - b) * dt.tex_rect.height), d);
           const float lum = 0.114f * d[0] + 0.587f * d[1] + 0.299f * d[2];
-          const float k = std::max(0.f, 1.f + dt.gain * (lum / dt.mean - 1.f));
+          const float k = std::max(0.f, 1.f + dt.gain * (std::min(lum / dt.mean, kMaxDetailRatio) - 1.f));
           for (int i = 0; i < 3; ++i) col[i] *= k;
         }
       } else {

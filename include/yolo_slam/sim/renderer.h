@@ -28,7 +28,7 @@ struct Sprite {
 struct SurfaceDetail {
   int texture = -1;     // index into the renderer's textures; -1 = no detail
   cv::Rect2f tex_rect;  // texel rectangle of level 0 spanning the quad (rows against edge_v)
-  float gain = 0.f;     // colour *= 1 + gain * (luminance / mean - 1), never below 0
+  float gain = 0.f;     // colour *= 1 + gain * (min(luminance / mean, 2) - 1), never below 0
   float mean = 128.f;   // luminance that leaves the colour unchanged (the crop's mean)
 };
 
