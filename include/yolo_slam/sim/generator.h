@@ -32,7 +32,7 @@ struct SynthOptions {
   // Gain of the fine pattern on every person (a seeded crop of a room photograph modulating
   // the luminance, moving with the person like a clothing pattern): the walker cut-outs are
   // upscaled low-resolution video and would otherwise carry far fewer keypoints than real
-  // people. 0 turns it off (the sequences of before it existed).
+  // people. 0: the plain cut-outs.
   double people_detail = 0.6;
   bool objects = true;                 // false: the same sequence without the boxes
   SensorOptions sensor;
@@ -102,6 +102,10 @@ struct PresetInfo {
   std::vector<Waypoint> schedule = {};     // non-empty: the walkers follow it instead (one walker)
   BoxMove box_move = {};                   // with a schedule: when the carried box moves
 };
+// Analogues of TUM's fr3 walking and sitting sequences, static_xyz (no people), loop, crowd
+// (seven walkers crossing and occluding each other, one carrying a box, the real
+// fr3_walking_xyz motion) and moved_object (a box picked up from the floor, carried and put
+// down again: static, dynamic, static).
 const std::vector<PresetInfo>& presets();
 
 class SequenceGenerator {
