@@ -19,14 +19,17 @@ static void usage() {
   std::printf(
       "usage: yolo_slam_synth --out DIR [--preset NAME] [--seed N] [--frames N] [--textures DIR]\n"
       "                       [--trajectory static|xyz|rpy|halfsphere|loop|FILE] [--config FILE]\n"
-      "                       [--motion-blur] [--no-noise] [--threads N]\n"
+      "                       [--motion-blur] [--no-noise] [--threads N] [--people-detail GAIN]\n"
+      "                       [--no-objects]\n"
       "       yolo_slam_synth --list-presets | --list-textures [--textures DIR]\n"
       "       yolo_slam_synth --contact-sheet PNG [--preset NAME ...]  (rgb, depth, mask of frames 0\n"
       "                       and 300 of each preset; all presets by default)\n"
       "Writes a TUM-format RGB-D sequence (rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt,\n"
       "associations.txt, camera.yaml) with dynamic ground truth (masks/, boxes.txt).\n"
       "Presets: walking_xyz (default) walking_static walking_rpy walking_half sitting_static\n"
-      "static_xyz loop. --frames 0 keeps the preset's length. Same --seed, same bytes.\n");
+      "static_xyz loop crowd moved_object. --frames 0 keeps the preset's length. Same --seed,\n"
+      "same bytes. --people-detail 0 drops the clothing pattern on people (default 0.6; 0: the\n"
+      "sequences of before it); --no-objects leaves out the boxes (compare moved_object's ATE).\n");
 }
 
 static long parseInt(const std::string& flag, const std::string& v, long lo) {
@@ -37,12 +40,21 @@ static long parseInt(const std::string& flag, const std::string& v, long lo) {
   return x;
 }
 
+static double parseGain(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end || !(x >= 0))
+    throw Error("bad value '" + v + "' for " + flag + ": expected a number >= 0");
+  return x;
+}
+
 int main(int argc, char** argv) {
   try {
     sim::SynthOptions opt;
     std::string out, config, sheet;
     std::vector<std::string> sheet_presets;
-    bool list_presets = false, list_textures = false, blur = false, no_noise = false;
+    bool list_presets = false, list_textures = false, blur = false, no_noise = false, no_objects = false;
+    double people_detail = -1;
     int threads = -1;
     long seed = -1, frames = -1;
     std::string preset, textures, trajectory;
@@ -64,6 +76,8 @@ int main(int argc, char** argv) {
       else if (a == "--threads") threads = (int)parseInt(a, val(), 1);
       else if (a == "--motion-blur") blur = true;
       else if (a == "--no-noise") no_noise = true;
+      else if (a == "--no-objects") no_objects = true;
+      else if (a == "--people-detail") people_detail = parseGain(a, val());
       else if (a == "--list-presets") list_presets = true;
       else if (a == "--list-textures") list_textures = true;
       else throw Error("unknown argument '" + a + "' (see --help)");
@@ -77,6 +91,8 @@ int main(int argc, char** argv) {
     if (threads > 0) opt.threads = threads;
     if (blur) opt.sensor.motion_blur = true;
     if (no_noise) opt.sensor.noise = false;
+    if (no_objects) opt.objects = false;
+    if (people_detail >= 0) opt.people_detail = people_detail;
 
     if (list_presets) {
       for (const auto& p : sim::presets())

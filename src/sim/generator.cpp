@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <sys/stat.h>
 #include <thread>
@@ -173,14 +174,28 @@ Pose startPose() { return lookAt(Eigen::Vector3d(0, 0, 1.35), Eigen::Vector3d(0,
 
 }  // namespace
 
-// A person: a walker (ping-pong along a floor segment) or a sitter (slight sway).
+// A person: a walker (ping-pong along a floor segment, or following a schedule) or a sitter
+// (slight sway).
 struct SequenceGenerator::Person {
   int id = 0;
   const SpriteTrack* track = nullptr;
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // floor points (sitter: a only)
+  std::vector<Waypoint> schedule;  // non-empty: followed instead of the a-b beat
   double speed = 1.0, phase = 0, height = 1.75, anim_phase = 0;
   bool sitting = false, mirror = false;
-  int box_id = 0;        // > 0: carries a box with this id
+  int box_id = 0;  // > 0: carries a box with this id
+  BoxMove box_move{-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  SurfaceDetail detail;              // texture, gain, mean; tex_rect is set per frame
+  double detail_tpm = 0;             // detail texels per metre of the person
+  cv::Point2f detail_anchor;         // texel under the person's feet (bottom centre)
+};
+
+// Where a person is at one instant.
+struct SequenceGenerator::PersonState {
+  Eigen::Vector3d pos = Eigen::Vector3d::Zero(), vel = Eigen::Vector3d::Zero();  // floor, m/s
+  Eigen::Vector3d heading = Eigen::Vector3d::Zero();  // unit: walking (or last walked) direction
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();    // unit: image right of its camera-facing billboard
+  double anim_t = 0;                                   // animation clock (s)
 };
 
 // Walkers 1.6 to 3.5 m from the camera's start, in front of the desks.
@@ -195,6 +210,20 @@ const std::vector<FloorSegment> kNearTripodPaths = {{-1.9, 1.3, 1.9, 1.7}, {1.7,
 // The loop's walker keeps to the left side so the circling camera never walks into it.
 const std::vector<FloorSegment> kLoopPath = {{-2.4, -1.0, -1.9, 2.6}};
 
+// crowd: seven crossing beats 1.2 to 3.7 m from the camera's start, two of them entering and
+// leaving through the image borders, one walking towards the camera and back.
+const std::vector<FloorSegment> kCrowdPaths = {{-2.2, 1.2, 2.2, 2.8},  {2.2, 1.3, -2.2, 2.9},
+                                               {-1.7, 1.2, 1.7, 1.2},  {-0.6, 1.3, 0.5, 2.9},
+                                               {-1.9, 1.0, -1.3, 2.9}, {1.5, 0.9, 1.2, 2.9},
+                                               {-2.4, 2.5, 2.4, 2.0}};
+// moved_object: the walker stands, fetches the box standing on the floor 2.7 m ahead, carries
+// it 2.2 m to the right, puts it down and leaves behind the camera. The floor comes into view
+// only beyond about 2.1 m, so both resting places lie farther.
+const std::vector<Waypoint> kMoveBoxWalk = {{0.0, -2.8, 2.2}, {3.0, -2.8, 2.2},  {4.5, -1.4, 2.7},
+                                            {5.5, -1.4, 2.7}, {8.0, 0.8, 2.5},   {9.0, 0.8, 2.5},
+                                            {11.0, 2.2, 1.0}, {13.5, 1.8, -1.2}};
+const BoxMove kMoveBoxTimes = {4.5, 9.0};
+
 const std::vector<PresetInfo>& presets() {
   static const std::vector<PresetInfo> p = {
       {"walking_xyz", "replay", "two people walking; the real fr3_walking_xyz camera motion", 827, 2, 0, false, kMidRoomPaths},
@@ -204,6 +233,8 @@ const std::vector<PresetInfo>& presets() {
       {"sitting_static", "static", "two people sitting at the desks, moving slightly", 707, 0, 2, false, {}},
       {"static_xyz", "xyz", "no people; camera translating along its axes", 900, 0, 0, false, {}},
       {"loop", "loop", "one walker; the camera circles the room and returns to its start", 1200, 1, 0, false, kLoopPath},
+      {"crowd", "replay", "seven people crossing and occluding each other, one carrying a box; the real fr3_walking_xyz camera motion", 860, 7, 0, true, kCrowdPaths},
+      {"moved_object", "xyz", "a person picks up a box standing on the floor, carries it and puts it down; camera translating along its axes", 600, 1, 0, true, {}, kMoveBoxWalk, kMoveBoxTimes},
   };
   return p;
 }
@@ -219,8 +250,11 @@ SynthOptions SynthOptions::load(const Config& cfg) {
   o.trajectory = cfg.getString("Synth.trajectory", o.trajectory);
   o.fps = cfg.getDouble("Synth.fps", o.fps);
   o.threads = cfg.getInt("Synth.threads", o.threads);
-  if (o.frames < 0 || o.fps <= 0 || o.threads < 1)
-    throw Error(cfg.path() + ": Synth.frames must be >= 0, Synth.fps > 0, Synth.threads >= 1");
+  o.people_detail = cfg.getDouble("Synth.peopleDetail", o.people_detail);
+  o.objects = cfg.getBool("Synth.objects", o.objects);
+  if (o.frames < 0 || o.fps <= 0 || o.threads < 1 || o.people_detail < 0)
+    throw Error(cfg.path() +
+                ": Synth.frames must be >= 0, Synth.fps > 0, Synth.threads >= 1, Synth.peopleDetail >= 0");
   o.sensor = SensorOptions::load(cfg);
   if (cfg.has("Camera.fx")) o.camera = CameraModel::load(cfg);
   return o;
@@ -268,110 +302,231 @@ SequenceGenerator::SequenceGenerator(const SynthOptions& opt) : opt_(opt) {
   // People.
   cv::RNG prng(mix(opt_.seed, 0xBEEF));
   int next_id = 1;
-  if (preset_.walkers > 0) {
-    walkers_ = cachedWalkers(opt_.walker_video.empty() ? defaultWalkerVideo() : opt_.walker_video);
-    const std::vector<FloorSegment>& segs = preset_.walker_paths;
-    if (segs.empty()) throw Error("preset '" + preset_.name + "' has walkers but no walker paths");
-    size_t first = (size_t)prng.uniform(0, (int)walkers_->size());
-    for (int k = 0; k < preset_.walkers; ++k) {
-      Person p;
-      p.id = next_id++;
-      p.track = &(*walkers_)[(first + 3 * k) % walkers_->size()];
+  addWalkers(prng, next_id);
+  addSitters(prng, next_id);
+  for (Person& p : people_) addDetail(p);
+  for (size_t i = 0; i < texture_files_.size(); ++i)
+    if (texture_files_[i] == "box_in_scene.png" || texture_files_[i] == "board.jpg") box_texture_ = (int)i;
+}
+
+namespace {
+
+constexpr double kBoxCarryHeight = 1.0;   // m: centre of a carried box (hip height)
+constexpr double kBoxRestHeight = 0.15;   // m: centre of the box standing on the floor
+constexpr double kBoxReach = 0.3;         // m: box centre ahead of the body
+constexpr double kWalkSpeed = 1.0;        // m/s of the walker videos' gait (schedule animation)
+constexpr double kDetailTexelsPerMetre = 420;  // clothing pattern scale, capped by the crop
+constexpr double kMaxGaitStretch = 1.15;  // head room of the detail crop for the gait bob
+constexpr uint64_t kDetailSeed = 0xD37A11;
+
+// 0 on the floor, 1 carried: lifted over kBoxLiftTime after pick_up, lowered before put_down.
+double liftFraction(const BoxMove& m, double t) {
+  const double up = (t - m.pick_up) / kBoxLiftTime, down = (m.put_down - t) / kBoxLiftTime;
+  return std::min(1.0, std::max(0.0, std::min(up, down)));
+}
+
+Eigen::Vector3d floorPoint(const Waypoint& w) { return Eigen::Vector3d(w.x, w.y, 0); }
+
+// Direction of the first leg of a schedule that moves (zero when it never moves).
+Eigen::Vector3d firstHeading(const std::vector<Waypoint>& w) {
+  for (size_t i = 0; i + 1 < w.size(); ++i) {
+    const Eigen::Vector3d d = floorPoint(w[i + 1]) - floorPoint(w[i]);
+    if (d.norm() > 1e-9) return d.normalized();
+  }
+  return Eigen::Vector3d::Zero();
+}
+
+// Position, velocity and heading of a scheduled walk at t; the gait advances with the distance
+// walked, so a standing walker holds its pose.
+void scheduleState(const std::vector<Waypoint>& w, double t, Eigen::Vector3d& pos, Eigen::Vector3d& vel,
+                          Eigen::Vector3d& heading, double& walked) {
+  heading = firstHeading(w);
+  walked = 0;
+  pos = floorPoint(w.back());
+  for (size_t i = 0; i + 1 < w.size(); ++i) {
+    const Eigen::Vector3d p0 = floorPoint(w[i]), d = floorPoint(w[i + 1]) - p0;
+    const double len = d.norm(), dt = w[i + 1].t - w[i].t;
+    if (t < w[i + 1].t) {
+      const double f = dt > 0 ? std::min(1.0, std::max(0.0, (t - w[i].t) / dt)) : 1.0;
+      pos = p0 + d * f;
+      walked += len * f;
+      if (len > 1e-9 && t >= w[i].t) vel = d / dt, heading = d / len;
+      return;
+    }
+    walked += len;
+    if (len > 1e-9) heading = d / len;
+  }
+}
+
+}  // namespace
+
+void SequenceGenerator::addWalkers(cv::RNG& prng, int& next_id) {
+  if (preset_.walkers <= 0) return;
+  walkers_ = cachedWalkers(opt_.walker_video.empty() ? defaultWalkerVideo() : opt_.walker_video);
+  const std::vector<FloorSegment>& segs = preset_.walker_paths;
+  if (segs.empty() && preset_.schedule.empty())
+    throw Error("preset '" + preset_.name + "' has walkers but no walker paths");
+  size_t first = (size_t)prng.uniform(0, (int)walkers_->size());
+  for (int k = 0; k < preset_.walkers; ++k) {
+    Person p;
+    p.id = next_id++;
+    p.track = &(*walkers_)[(first + 3 * k) % walkers_->size()];
+    if (!preset_.schedule.empty()) {
+      p.schedule = preset_.schedule;
+    } else {
       const FloorSegment& seg = segs[k % segs.size()];
       p.a = Eigen::Vector3d(seg.ax, seg.ay, 0);
       p.b = Eigen::Vector3d(seg.bx, seg.by, 0);
-      p.speed = prng.uniform(0.8, 1.2);
-      p.phase = prng.uniform(0.0, 1.0);
-      p.height = prng.uniform(1.65, 1.85);
-      p.anim_phase = prng.uniform(0.0, 10.0);
-      people_.push_back(p);
     }
-    if (preset_.carried_box && !people_.empty()) people_.back().box_id = 100;
+    p.speed = prng.uniform(0.8, 1.2);
+    p.phase = prng.uniform(0.0, 1.0);
+    p.height = prng.uniform(1.65, 1.85);
+    p.anim_phase = prng.uniform(0.0, 10.0);
+    people_.push_back(p);
   }
-  if (preset_.sitters > 0) {
-    sitters_ = cachedTumPeople(opt_.tum_people_dir.empty() ? defaultTumPeopleDir() : opt_.tum_people_dir);
-    const Eigen::Vector3d seats[2] = {Eigen::Vector3d(-0.75, 2.6, 0), Eigen::Vector3d(0.8, 2.5, 0)};
-    for (int k = 0; k < preset_.sitters; ++k) {
-      Person p;
-      p.id = next_id++;
-      p.track = &(*sitters_)[k % sitters_->size()];
-      p.a = seats[k % 2];
-      p.sitting = true;
-      p.mirror = k % 2 == 1;
-      p.height = p.track->height_m;
-      p.phase = prng.uniform(0.0, 2 * kPi);
-      people_.push_back(p);
-    }
+  if (preset_.carried_box && !people_.empty()) {
+    people_.back().box_id = 100;
+    if (!preset_.schedule.empty()) people_.back().box_move = preset_.box_move;
   }
-  for (size_t i = 0; i < texture_files_.size(); ++i)
-    if (texture_files_[i] == "box_in_scene.png" || texture_files_[i] == "board.jpg") box_texture_ = (int)i;
+}
+
+void SequenceGenerator::addSitters(cv::RNG& prng, int& next_id) {
+  if (preset_.sitters <= 0) return;
+  sitters_ = cachedTumPeople(opt_.tum_people_dir.empty() ? defaultTumPeopleDir() : opt_.tum_people_dir);
+  const Eigen::Vector3d seats[2] = {Eigen::Vector3d(-0.75, 2.6, 0), Eigen::Vector3d(0.8, 2.5, 0)};
+  for (int k = 0; k < preset_.sitters; ++k) {
+    Person p;
+    p.id = next_id++;
+    p.track = &(*sitters_)[k % sitters_->size()];
+    p.a = seats[k % 2];
+    p.sitting = true;
+    p.mirror = k % 2 == 1;
+    p.height = p.track->height_m;
+    p.phase = prng.uniform(0.0, 2 * kPi);
+    people_.push_back(p);
+  }
+}
+
+// The person's clothing pattern: a crop of a random photograph (its own random generator, so
+// the other random choices stay those of sequences without detail), kDetailTexelsPerMetre
+// unless the photograph is too small for the person's tallest and widest frame.
+void SequenceGenerator::addDetail(Person& p) const {
+  if (opt_.people_detail <= 0) return;
+  cv::RNG rng(mix(opt_.seed, kDetailSeed + (uint64_t)p.id));
+  const int ti = rng.uniform(0, (int)textures_.size());
+  const Texture& tx = textures_[ti];
+  double aspect = 0;
+  for (const Sprite& sp : p.track->frames) aspect = std::max(aspect, (double)sp.bgra.cols / sp.bgra.rows);
+  const double h_m = p.height * kMaxGaitStretch, w_m = h_m * aspect;
+  const double tpm = std::min({kDetailTexelsPerMetre, tx.height() / h_m, tx.width() / w_m});
+  const float w = (float)(w_m * tpm), h = (float)(h_m * tpm);
+  p.detail_anchor = cv::Point2f(rng.uniform(0.5f * w, std::max(0.5f * w + 1e-3f, tx.width() - 0.5f * w)),
+                                rng.uniform(h, std::max(h + 1e-3f, (float)tx.height())));
+  p.detail_tpm = tpm;
+  p.detail.texture = ti;
+  p.detail.gain = (float)opt_.people_detail;
+  const cv::Rect crop = cv::Rect((int)(p.detail_anchor.x - 0.5f * w), (int)(p.detail_anchor.y - h), (int)w, (int)h) &
+                        cv::Rect(0, 0, tx.width(), tx.height());
+  const cv::Scalar m = cv::mean(tx.levels[0](crop));
+  p.detail.mean = (float)std::max(1.0, 0.114 * m[0] + 0.587 * m[1] + 0.299 * m[2]);
+}
+
+SequenceGenerator::PersonState SequenceGenerator::personAt(const Person& p, double t) const {
+  PersonState st;
+  st.anim_t = t + p.anim_phase;
+  if (p.sitting) {
+    st.pos = p.a;
+  } else if (!p.schedule.empty()) {
+    double walked = 0;
+    scheduleState(p.schedule, t, st.pos, st.vel, st.heading, walked);
+    st.anim_t = walked / kWalkSpeed + p.anim_phase;
+  } else {
+    Eigen::Vector3d d = p.b - p.a;
+    double L = d.norm();
+    double s = std::fmod(p.phase * 2 * L + t * p.speed, 2 * L);
+    if (s < L) st.pos = p.a + d * (s / L), st.vel = d / L * p.speed;
+    else st.pos = p.b - d * ((s - L) / L), st.vel = -d / L * p.speed;
+    st.heading = st.vel.normalized();
+  }
+  return st;
+}
+
+// Billboard facing the camera (horizontally), standing on the floor.
+Quad SequenceGenerator::personQuad(const Person& p, const PersonState& st, double t) const {
+  Eigen::Vector3d pos = st.pos;
+  if (p.sitting) pos += st.right * (0.03 * std::sin(2 * kPi * t / 5.0 + p.phase));
+  size_t k = p.track->fps > 0 ? (size_t)std::floor(st.anim_t * p.track->fps) % p.track->frames.size() : 0;
+  const Sprite& sp = p.track->frames[k];
+  double hs = p.height * p.track->height_scale[k];
+  if (p.sitting) hs *= 1.0 + 0.01 * std::sin(2 * kPi * t / 3.7 + p.phase);
+  double ws = hs * sp.bgra.cols / sp.bgra.rows;
+  Quad q;
+  q.origin = pos - st.right * (0.5 * ws);
+  q.edge_u = st.right * ws;
+  q.edge_v = kUp * hs;
+  q.sprite = &sp;
+  q.object_id = p.id;
+  // Sprites face +u: mirror when walking (or, standing, last walked) towards the image left.
+  const Eigen::Vector3d& facing = st.vel.squaredNorm() > 0 ? st.vel : st.heading;
+  bool mirror = p.sitting ? p.mirror : facing.dot(st.right) < 0;
+  q.tex_rect = mirror ? cv::Rect2f((float)sp.bgra.cols, 0, -(float)sp.bgra.cols, (float)sp.bgra.rows)
+                      : cv::Rect2f(0, 0, (float)sp.bgra.cols, (float)sp.bgra.rows);
+  if (p.detail.texture >= 0) {
+    // A fixed scale in texels per metre, so the pattern does not stretch with the gait.
+    q.detail = p.detail;
+    const float w = (float)(ws * p.detail_tpm), h = (float)(hs * p.detail_tpm);
+    q.detail.tex_rect = cv::Rect2f(p.detail_anchor.x - 0.5f * w, p.detail_anchor.y - h, w, h);
+  }
+  return q;
+}
+
+// The box held at hip height in front of the body, on the side it walks towards; while it
+// rests on the floor (before pick-up, after put-down) it is static scene (object id 0).
+void SequenceGenerator::addBoxQuads(const Person& p, const PersonState& st, double t, std::vector<Quad>& out) const {
+  const BoxMove& m = p.box_move;
+  const double tb = std::min(std::max(t, m.pick_up), m.put_down);
+  const PersonState sb = tb == t ? st : personAt(p, tb);
+  const bool moving = t > m.pick_up && t < m.put_down;
+  const double lift = liftFraction(m, tb);
+  const double height = lift >= 1.0 ? kBoxCarryHeight : kBoxRestHeight + lift * (kBoxCarryHeight - kBoxRestHeight);
+  Eigen::Vector3d dir = sb.heading.squaredNorm() > 0 ? sb.heading : st.right;
+  Eigen::Vector3d side = kUp.cross(dir);
+  Eigen::Vector3d c = sb.pos + dir * kBoxReach + kUp * height;
+  Eigen::Vector3d ex = dir * 0.4, ey = side * 0.3, ez = kUp * 0.3;
+  Eigen::Vector3d lo = c - 0.5 * (ex + ey + ez);
+  auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev) {
+    Quad f;
+    f.origin = o;
+    f.edge_u = eu;
+    f.edge_v = ev;
+    f.texture = box_texture_;
+    const Texture& tx = textures_[box_texture_];
+    f.tex_rect = cv::Rect2f(0, 0, (float)tx.width() * 0.5f, (float)tx.height() * 0.5f);
+    f.brightness = 0.9f;
+    f.two_sided = false;
+    f.object_id = moving ? p.box_id : 0;
+    out.push_back(f);
+  };
+  // Outward normals (edge_u x edge_v) for back-face culling.
+  face(lo, ex, ez);       // -ey
+  face(lo + ey, ez, ex);  // +ey
+  face(lo, ez, ey);       // -ex
+  face(lo + ex, ey, ez);  // +ex
+  face(lo + ez, ex, ey);  // +ez
+  face(lo, ey, ex);       // -ez
 }
 
 std::vector<Quad> SequenceGenerator::dynamicQuads(double t, const Pose& T_wc) const {
   std::vector<Quad> out;
   const Eigen::Vector3d cam = T_wc.translation();
   for (const Person& p : people_) {
-    Eigen::Vector3d pos, vel = Eigen::Vector3d::Zero();
-    if (p.sitting) {
-      pos = p.a;
-    } else {
-      Eigen::Vector3d d = p.b - p.a;
-      double L = d.norm();
-      double s = std::fmod(p.phase * 2 * L + t * p.speed, 2 * L);
-      if (s < L) pos = p.a + d * (s / L), vel = d / L * p.speed;
-      else pos = p.b - d * ((s - L) / L), vel = -d / L * p.speed;
-    }
-    // Billboard facing the camera (horizontally), standing on the floor.
-    Eigen::Vector3d n = cam - pos;
+    PersonState st = personAt(p, t);
+    Eigen::Vector3d n = cam - st.pos;
     n.z() = 0;
     if (n.norm() < 1e-6) continue;
-    n.normalize();
-    Eigen::Vector3d right = kUp.cross(n);
-    if (p.sitting) pos += right * (0.03 * std::sin(2 * kPi * t / 5.0 + p.phase));
-    size_t k = p.track->fps > 0 ? (size_t)std::floor((t + p.anim_phase) * p.track->fps) % p.track->frames.size() : 0;
-    const Sprite& sp = p.track->frames[k];
-    double hs = p.height * p.track->height_scale[k];
-    if (p.sitting) hs *= 1.0 + 0.01 * std::sin(2 * kPi * t / 3.7 + p.phase);
-    double ws = hs * sp.bgra.cols / sp.bgra.rows;
-    Quad q;
-    q.origin = pos - right * (0.5 * ws);
-    q.edge_u = right * ws;
-    q.edge_v = kUp * hs;
-    q.sprite = &sp;
-    q.object_id = p.id;
-    // Sprites face +u: mirror when walking towards the left of the image.
-    bool mirror = p.sitting ? p.mirror : vel.dot(right) < 0;
-    q.tex_rect = mirror ? cv::Rect2f((float)sp.bgra.cols, 0, -(float)sp.bgra.cols, (float)sp.bgra.rows)
-                        : cv::Rect2f(0, 0, (float)sp.bgra.cols, (float)sp.bgra.rows);
-    out.push_back(q);
-    if (p.box_id > 0) {
-      // A box held at hip height in front of the body, on the side it walks towards.
-      Eigen::Vector3d dir = vel.norm() > 1e-6 ? Eigen::Vector3d(vel.normalized()) : right;
-      Eigen::Vector3d side = kUp.cross(dir);
-      Eigen::Vector3d c = pos + dir * 0.3 + kUp * 1.0;
-      Eigen::Vector3d ex = dir * 0.4, ey = side * 0.3, ez = kUp * 0.3;
-      Eigen::Vector3d lo = c - 0.5 * (ex + ey + ez);
-      auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& eu, const Eigen::Vector3d& ev) {
-        Quad f;
-        f.origin = o;
-        f.edge_u = eu;
-        f.edge_v = ev;
-        f.texture = box_texture_;
-        const Texture& tx = textures_[box_texture_];
-        f.tex_rect = cv::Rect2f(0, 0, (float)tx.width() * 0.5f, (float)tx.height() * 0.5f);
-        f.brightness = 0.9f;
-        f.two_sided = false;
-        f.object_id = p.box_id;
-        out.push_back(f);
-      };
-      // Outward normals (edge_u x edge_v) for back-face culling.
-      face(lo, ex, ez);       // -ey
-      face(lo + ey, ez, ex);  // +ey
-      face(lo, ez, ey);       // -ex
-      face(lo + ex, ey, ez);  // +ex
-      face(lo + ez, ex, ey);  // +ez
-      face(lo, ey, ex);       // -ez
-    }
+    st.right = kUp.cross(n.normalized());
+    out.push_back(personQuad(p, st, t));
+    if (p.box_id > 0 && opt_.objects) addBoxQuads(p, st, t, out);
   }
   return out;
 }
@@ -398,7 +553,7 @@ SynthFrame SequenceGenerator::frame(size_t i) const {
   // Per-object truth from the id buffer.
   std::vector<int> ids;
   for (const Quad& q : dyn)
-    if (std::find(ids.begin(), ids.end(), q.object_id) == ids.end()) ids.push_back(q.object_id);
+    if (q.object_id > 0 && std::find(ids.begin(), ids.end(), q.object_id) == ids.end()) ids.push_back(q.object_id);
   for (int id : ids) {
     cv::Mat m = ro.ids == id;
     int px = cv::countNonZero(m);

@@ -10,6 +10,9 @@ namespace sim {
 namespace {
 
 constexpr double kNear = 0.05;  // metres: geometry nearer than this is clipped
+// Brightest detail texel relative to its crop's mean: bright specks in a dark crop would
+// otherwise turn parts of a person white.
+constexpr float kMaxDetailRatio = 2.f;
 
 // A quad transformed into the camera frame, with the plane facing the camera (h < 0).
 struct Setup {
@@ -84,6 +87,92 @@ inline void bilinear4(const cv::Mat& img, float x, float y, float out[4]) {
 
 inline uchar sat(float v) { return (uchar)std::min(255.f, std::max(0.f, v + 0.5f)); }
 
+// Texels of level 0 per metre of surface (worst direction), for the mip level.
+double texelsPerMetre(const cv::Rect2f& tr, const Setup& s) {
+  return std::max(std::abs(tr.width) * std::sqrt(s.inv_eu2), std::abs(tr.height) * std::sqrt(s.inv_ev2));
+}
+
+// Bilinear sample of the mip level matching the pixel's footprint on the texture, which grows
+// with depth and with obliquity (`cosang`: cosine between the ray and the surface normal).
+inline void mipSample(const Texture& tex, double tpm, double z_ifx, double cosang, float tx, float ty,
+                      float col[3]) {
+  const double fp = z_ifx * tpm / std::sqrt(std::max(cosang, 0.05));
+  int L = 0;
+  if (fp > 1.0) L = std::min((int)tex.levels.size() - 1, std::ilogb(fp));
+  const float sc = 1.f / (float)(1 << L);
+  bilinear3(tex.levels[L], tx * sc - 0.5f, ty * sc - 0.5f, col);
+}
+
+// Everything drawQuad needs besides the quad.
+struct DrawContext {
+  const CameraModel& cam;
+  const std::vector<Texture>& textures;
+  RenderOutput& out;
+};
+
+void drawQuad(const DrawContext& c, const Quad& q, const Setup& s) {
+  const double ifx = 1.0 / c.cam.fx, ify = 1.0 / c.cam.fy;
+  const Texture* tex = q.sprite ? nullptr : &c.textures.at(q.texture);
+  const cv::Rect2f tr = q.tex_rect;
+  const double tpm = texelsPerMetre(tr, s);
+  const SurfaceDetail& dt = q.detail;
+  const Texture* detail = q.sprite && dt.texture >= 0 && dt.gain != 0.f ? &c.textures.at(dt.texture) : nullptr;
+  const double detail_tpm = detail ? texelsPerMetre(dt.tex_rect, s) : 0;
+  const float gb = q.brightness * q.tint[0], gg = q.brightness * q.tint[1], gr = q.brightness * q.tint[2];
+  const float sat_k = q.saturation;
+  const bool grade = sat_k != 1.f;
+  for (int v = s.y0; v <= s.y1; ++v) {
+    const double yt = (v - c.cam.cy) * ify;
+    float* zrow = c.out.depth.ptr<float>(v);
+    uchar* crow = c.out.bgr.ptr<uchar>(v);
+    uint16_t* irow = c.out.ids.ptr<uint16_t>(v);
+    for (int u = s.x0; u <= s.x1; ++u) {
+      const double xt = (u - c.cam.cx) * ifx;
+      const double D = s.n.x() * xt + s.n.y() * yt + s.n.z();
+      if (D >= -1e-12) continue;
+      const double invD = 1.0 / D;
+      float z = (float)(s.h * invD);
+      if (z >= zrow[u] || z < kNear) continue;
+      const double a = (s.h * (s.eu.x() * xt + s.eu.y() * yt + s.eu.z()) * invD - s.euo) * s.inv_eu2;
+      if (a < 0 || a > 1) continue;
+      const double b = (s.h * (s.ev.x() * xt + s.ev.y() * yt + s.ev.z()) * invD - s.evo) * s.inv_ev2;
+      if (b < 0 || b > 1) continue;
+      const float tx = (float)(tr.x + a * tr.width), ty = (float)(tr.y + (1 - b) * tr.height);
+      const double cosang = -D / std::sqrt(xt * xt + yt * yt + 1.0);
+      float col[4];
+      if (q.sprite) {
+        const cv::Mat& img = q.sprite->bgra;
+        bilinear4(img, tx - 0.5f, ty - 0.5f, col);
+        if (col[3] < 128.f) continue;
+        int rx = std::min(std::max((int)tx, 0), img.cols - 1);
+        int ry = std::min(std::max((int)ty, 0), img.rows - 1);
+        const float z_plane = z;
+        z -= q.sprite->relief.at<float>(ry, rx);
+        if (z >= zrow[u] || z < kNear) continue;
+        if (detail) {
+          float d[3];
+          mipSample(*detail, detail_tpm, z_plane * ifx, cosang, (float)(dt.tex_rect.x + a * dt.tex_rect.width),
+                    (float)(dt.tex_rect.y + (1 - b) * dt.tex_rect.height), d);
+          const float lum = 0.114f * d[0] + 0.587f * d[1] + 0.299f * d[2];
+          const float k = std::max(0.f, 1.f + dt.gain * (std::min(lum / dt.mean, kMaxDetailRatio) - 1.f));
+          for (int i = 0; i < 3; ++i) col[i] *= k;
+        }
+      } else {
+        mipSample(*tex, tpm, z * ifx, cosang, tx, ty, col);
+      }
+      if (grade) {
+        const float grey = 0.114f * col[0] + 0.587f * col[1] + 0.299f * col[2];
+        for (int k = 0; k < 3; ++k) col[k] = grey + sat_k * (col[k] - grey);
+      }
+      zrow[u] = z;
+      crow[3 * u] = sat(col[0] * gb);
+      crow[3 * u + 1] = sat(col[1] * gg);
+      crow[3 * u + 2] = sat(col[2] * gr);
+      irow[u] = (uint16_t)q.object_id;
+    }
+  }
+}
+
 }  // namespace
 
 Renderer::Renderer(const CameraModel& cam, const std::vector<Texture>& textures)
@@ -109,66 +198,10 @@ void Renderer::render(const Pose& T_wc, const std::vector<Quad>& quads, RenderOu
   }
   std::sort(order.begin(), order.end());
 
-  const double ifx = 1.0 / cam_.fx, ify = 1.0 / cam_.fy;
+  const DrawContext ctx{cam_, textures_, out};
   for (const auto& oi : order) {
-    const Quad& q = quads[oi.second];
     Setup s;
-    if (!setupQuad(cam_, T_cw, q, 0, 0, W - 1, H - 1, s)) continue;
-    const Texture* tex = q.sprite ? nullptr : &textures_.at(q.texture);
-    const cv::Rect2f tr = q.sprite ? cv::Rect2f(q.tex_rect) : q.tex_rect;
-    // Texels of level 0 per metre of surface (worst direction), for the mip level.
-    const double tpm = std::max(std::abs(tr.width) * std::sqrt(s.inv_eu2),
-                                std::abs(tr.height) * std::sqrt(s.inv_ev2));
-    const int n_levels = tex ? (int)tex->levels.size() : 1;
-    const float gb = q.brightness * q.tint[0], gg = q.brightness * q.tint[1], gr = q.brightness * q.tint[2];
-    const float sat_k = q.saturation;
-    const bool grade = sat_k != 1.f;
-    for (int v = s.y0; v <= s.y1; ++v) {
-      const double yt = (v - cam_.cy) * ify;
-      float* zrow = out.depth.ptr<float>(v);
-      uchar* crow = out.bgr.ptr<uchar>(v);
-      uint16_t* irow = out.ids.ptr<uint16_t>(v);
-      for (int u = s.x0; u <= s.x1; ++u) {
-        const double xt = (u - cam_.cx) * ifx;
-        const double D = s.n.x() * xt + s.n.y() * yt + s.n.z();
-        if (D >= -1e-12) continue;
-        const double invD = 1.0 / D;
-        float z = (float)(s.h * invD);
-        if (z >= zrow[u] || z < kNear) continue;
-        const double a = (s.h * (s.eu.x() * xt + s.eu.y() * yt + s.eu.z()) * invD - s.euo) * s.inv_eu2;
-        if (a < 0 || a > 1) continue;
-        const double b = (s.h * (s.ev.x() * xt + s.ev.y() * yt + s.ev.z()) * invD - s.evo) * s.inv_ev2;
-        if (b < 0 || b > 1) continue;
-        const float tx = (float)(tr.x + a * tr.width), ty = (float)(tr.y + (1 - b) * tr.height);
-        float col[4];
-        if (q.sprite) {
-          const cv::Mat& img = q.sprite->bgra;
-          bilinear4(img, tx - 0.5f, ty - 0.5f, col);
-          if (col[3] < 128.f) continue;
-          int rx = std::min(std::max((int)tx, 0), img.cols - 1);
-          int ry = std::min(std::max((int)ty, 0), img.rows - 1);
-          z -= q.sprite->relief.at<float>(ry, rx);
-          if (z >= zrow[u] || z < kNear) continue;
-        } else {
-          // Footprint of the pixel on the texture: grows with depth and with obliquity.
-          const double cosang = -D / std::sqrt(xt * xt + yt * yt + 1.0);
-          const double fp = z * ifx * tpm / std::sqrt(std::max(cosang, 0.05));
-          int L = 0;
-          if (fp > 1.0) L = std::min(n_levels - 1, std::ilogb(fp));
-          const float sc = 1.f / (float)(1 << L);
-          bilinear3(tex->levels[L], tx * sc - 0.5f, ty * sc - 0.5f, col);
-        }
-        if (grade) {
-          const float grey = 0.114f * col[0] + 0.587f * col[1] + 0.299f * col[2];
-          for (int k = 0; k < 3; ++k) col[k] = grey + sat_k * (col[k] - grey);
-        }
-        zrow[u] = z;
-        crow[3 * u] = sat(col[0] * gb);
-        crow[3 * u + 1] = sat(col[1] * gg);
-        crow[3 * u + 2] = sat(col[2] * gr);
-        irow[u] = (uint16_t)q.object_id;
-      }
-    }
+    if (setupQuad(cam_, T_cw, quads[oi.second], 0, 0, W - 1, H - 1, s)) drawQuad(ctx, quads[oi.second], s);
   }
   // Pixels that saw nothing (outside the room) have no depth.
   cv::Mat none = out.depth == std::numeric_limits<float>::infinity();

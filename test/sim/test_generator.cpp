@@ -1,5 +1,6 @@
 // Checks of the synthetic sequence generator: geometry of the rendering, determinism, the TUM
-// layout, masks against boxes and the depth sensor model.
+// layout, masks against boxes, the depth sensor model, the people's detail and the crowd and
+// moved_object presets.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -9,6 +10,7 @@
 #include "yolo_slam/sim/generator.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -53,6 +55,23 @@ sim::SynthOptions opts(const std::string& preset, int frames, unsigned seed = 1)
   o.frames = frames;
   o.seed = seed;
   return o;
+}
+
+// A quarter-size camera (320x240) for the checks that need only the layout of a frame.
+sim::SynthOptions smallOpts(const std::string& preset, int frames, unsigned seed = 1) {
+  sim::SynthOptions o = opts(preset, frames, seed);
+  o.camera.width /= 2, o.camera.height /= 2;
+  o.camera.fx /= 2, o.camera.fy /= 2, o.camera.cx /= 2, o.camera.cy /= 2;
+  return o;
+}
+
+// Share of ORB keypoints (1000 features) of an image that fall on person pixels.
+double personKeypointShare(const sim::SynthFrame& f) {
+  std::vector<cv::KeyPoint> kps;
+  cv::ORB::create(1000)->detect(f.bgr, kps);
+  int on = 0;
+  for (const auto& k : kps) on += f.mask.at<uint8_t>(cv::Point(k.pt)) == sim::kMaskPerson;
+  return kps.empty() ? 0.0 : (double)on / kps.size();
 }
 
 }  // namespace
@@ -293,4 +312,82 @@ TEST(SimGenerator, ErrorsNameTheCause) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/groundtruth.txt"), std::string::npos);
   }
+}
+
+// The clothing pattern puts keypoints on the blurry walker cut-outs, and the same seed still
+// gives the same image.
+TEST(SimGenerator, PeopleDetailRaisesKeypointsOnPeople) {
+  sim::SynthOptions o = opts("walking_xyz", 61);
+  sim::SequenceGenerator with(o);
+  o.people_detail = 0;
+  sim::SequenceGenerator without(o);
+  double on = 0, off = 0;
+  for (size_t i : {0, 30, 60}) {
+    sim::SynthFrame a = with.frame(i), b = without.frame(i);
+    ASSERT_GT(cv::countNonZero(a.mask == sim::kMaskPerson), 2000) << "frame " << i << " shows no one";
+    EXPECT_EQ(cv::countNonZero(a.mask != b.mask), 0) << "the detail must not move anyone";
+    on += personKeypointShare(a), off += personKeypointShare(b);
+  }
+  std::printf("ORB keypoints on people: detail on %.3f, off %.3f\n", on / 3, off / 3);
+  EXPECT_GT(on, 1.3 * off);
+  cv::Mat again = sim::SequenceGenerator(opts("walking_xyz", 61)).frame(30).bgr;
+  EXPECT_EQ(cv::countNonZero(cv::Mat(again != with.frame(30).bgr).reshape(1)), 0);
+}
+
+// crowd: at least six people, crossing so that their boxes overlap, some cut by the border.
+TEST(SimGenerator, CrowdCrossesAndReachesTheBorders) {
+  sim::SequenceGenerator gen(smallOpts("crowd", 40));
+  const cv::Size sz(gen.camera().width, gen.camera().height);
+  std::set<int> people;
+  int overlaps = 0, at_border = 0, boxes = 0;
+  for (size_t i = 0; i < gen.size(); i += 4) {
+    sim::SynthFrame f = gen.frame(i);
+    std::vector<cv::Rect> persons;
+    for (const auto& o : f.objects) {
+      if (o.cls != "person") {
+        ++boxes;
+        continue;
+      }
+      people.insert(o.id);
+      persons.push_back(o.box);
+      at_border += o.box.x == 0 || o.box.br().x == sz.width;
+    }
+    for (size_t a = 0; a < persons.size(); ++a)
+      for (size_t b = a + 1; b < persons.size(); ++b) overlaps += (persons[a] & persons[b]).area() > 0;
+  }
+  EXPECT_GE(people.size(), 6u);
+  EXPECT_GT(overlaps, 0) << "no two people occlude each other";
+  EXPECT_GT(at_border, 0) << "no person is cut by the image border";
+  EXPECT_GT(boxes, 0) << "the carried box is never seen";
+}
+
+namespace {
+
+int boxPixels(const sim::SynthFrame& f) { return cv::countNonZero(f.mask == sim::kMaskOtherObject); }
+
+}  // namespace
+
+// moved_object: the box is static scene (mask 0, no box row) before it is picked up and after
+// it is put down, dynamic while carried; without objects the resting box is gone.
+TEST(SimGenerator, MovedObjectIsDynamicOnlyWhileCarried) {
+  sim::SynthOptions o = smallOpts("moved_object", 0);
+  sim::SequenceGenerator gen(o);
+  o.objects = false;
+  sim::SequenceGenerator bare(o);
+  const size_t carried = (size_t)(0.5 * (4.5 + 9.0) * o.fps);
+  sim::SynthFrame first = gen.frame(0), mid = gen.frame(carried), last = gen.frame(gen.size() - 1);
+  EXPECT_EQ(boxPixels(first), 0);
+  EXPECT_EQ(boxPixels(last), 0);
+  EXPECT_GT(boxPixels(mid), 100);
+  for (const sim::SynthFrame* f : {&first, &last})
+    for (const auto& ob : f->objects) EXPECT_EQ(ob.cls, "person") << "frame " << f->index;
+  EXPECT_TRUE(std::any_of(mid.objects.begin(), mid.objects.end(),
+                          [](const sim::ObjectTruth& ob) { return ob.cls == "box"; }));
+  // The resting box is in view: leaving it out changes static pixels.
+  for (size_t i : {(size_t)0, gen.size() - 1}) {
+    sim::SynthFrame a = gen.frame(i), b = bare.frame(i);
+    EXPECT_GT(cv::countNonZero(cv::abs(a.depth_exact - b.depth_exact) > 0.05f), 100) << "frame " << i;
+    EXPECT_EQ(boxPixels(b), 0);
+  }
+  EXPECT_EQ(boxPixels(bare.frame(carried)), 0);
 }

@@ -20,7 +20,7 @@ namespace sim {
 
 struct SynthOptions {
   std::string preset = "walking_xyz";  // walking_xyz|walking_static|walking_rpy|walking_half|
-                                       // sitting_static|static_xyz|loop
+                                       // sitting_static|static_xyz|loop|crowd|moved_object
   unsigned seed = 1;                   // same seed, same bytes
   int frames = 0;                      // 0: the preset's length; N: the first N frames
   std::string textures_dir;            // "": defaultTextureDir() with defaultTextureFiles()
@@ -29,17 +29,26 @@ struct SynthOptions {
   std::string tum_people_dir;          // "": defaultTumPeopleDir()
   double fps = 30.0;
   int threads = 2;                     // frames rendered in parallel by generate()
+  // Gain of the fine pattern on every person (a seeded crop of a room photograph modulating
+  // the luminance, moving with the person like a clothing pattern): the walker cut-outs are
+  // upscaled low-resolution video and would otherwise carry far fewer keypoints than real
+  // people. 0: the plain cut-outs.
+  double people_detail = 0.6;
+  bool objects = true;                 // false: the same sequence without the boxes
   SensorOptions sensor;
   CameraModel camera;                  // freiburg3 intrinsics, 640x480
 
   // Synth.preset, Synth.seed, Synth.frames, Synth.textures, Synth.trajectory, Synth.fps,
-  // Synth.threads, plus SensorOptions keys; Camera.* keys if present.
+  // Synth.threads, Synth.peopleDetail, Synth.objects (0/1), plus SensorOptions keys; Camera.*
+  // keys if present.
   static SynthOptions load(const Config& cfg);
 };
 
 // Values of the dynamic mask (masks/*.png): every value > 127 is dynamic, as in other masks;
 // a person is told apart from another moving object (the carried box of walking_half), since
-// dynamic recall is defined over the people a person detector is asked to find.
+// dynamic recall is defined over the people a person detector is asked to find. A box is
+// dynamic only while it moves: moved_object's box standing on the floor before it is picked up
+// and after it is put down is static scene (mask 0, no boxes.txt row).
 constexpr uint8_t kMaskPerson = 255;
 constexpr uint8_t kMaskOtherObject = 200;
 
@@ -70,12 +79,33 @@ struct FloorSegment {
   double ax, ay, bx, by;
 };
 
+// A stop of a scheduled walk: the walker is at (x, y) on the floor at time t (seconds) and
+// walks in a straight line to the next stop; two stops at one place make it stand; it stays
+// at the last stop.
+struct Waypoint {
+  double t, x, y;
+};
+
+// What a scheduled walker does with the box: it rests on the floor in front of the walker until
+// pick_up (s), is lifted, carried and lowered back onto the floor until put_down (s) and rests
+// there afterwards. The walker should stand still while lifting and lowering (kBoxLiftTime).
+struct BoxMove {
+  double pick_up, put_down;
+};
+constexpr double kBoxLiftTime = 1.0;  // seconds to lift the box from the floor or put it down
+
 struct PresetInfo {
   std::string name, motion, description;
   int frames, walkers, sitters;
-  bool carried_box;
+  bool carried_box;                        // the last walker carries a box (id 100)
   std::vector<FloorSegment> walker_paths;  // walker k takes path k modulo the count
+  std::vector<Waypoint> schedule = {};     // non-empty: the walkers follow it instead (one walker)
+  BoxMove box_move = {};                   // with a schedule: when the carried box moves
 };
+// Analogues of TUM's fr3 walking and sitting sequences, static_xyz (no people), loop, crowd
+// (seven walkers crossing and occluding each other, one carrying a box, the real
+// fr3_walking_xyz motion) and moved_object (a box picked up from the floor, carried and put
+// down again: static, dynamic, static).
 const std::vector<PresetInfo>& presets();
 
 class SequenceGenerator {
@@ -107,6 +137,13 @@ class SequenceGenerator {
                   const std::vector<std::vector<ObjectTruth>>& objects) const;
   void writeCameraAndInfo(const std::string& out_dir, const std::string& src) const;
   struct Person;
+  struct PersonState;
+  void addWalkers(cv::RNG& rng, int& next_id);
+  void addSitters(cv::RNG& rng, int& next_id);
+  void addDetail(Person& p) const;
+  PersonState personAt(const Person& p, double t) const;
+  Quad personQuad(const Person& p, const PersonState& st, double t) const;
+  void addBoxQuads(const Person& p, const PersonState& st, double t, std::vector<Quad>& out) const;
   std::vector<Quad> dynamicQuads(double t, const Pose& T_wc) const;
 
   SynthOptions opt_;

@@ -22,6 +22,16 @@ struct Sprite {
   cv::Mat relief;
 };
 
+// Fine pattern fixed to a quad's surface (clothing on a person): a crop of one of the renderer's
+// textures, laid over the quad in its own (a, b) coordinates, scales the luminance of the quad's
+// colour, so the pattern moves rigidly with the quad whatever its sprite shows.
+struct SurfaceDetail {
+  int texture = -1;     // index into the renderer's textures; -1 = no detail
+  cv::Rect2f tex_rect;  // texel rectangle of level 0 spanning the quad (rows against edge_v)
+  float gain = 0.f;     // colour *= 1 + gain * (min(luminance / mean, 2) - 1), never below 0
+  float mean = 128.f;   // luminance that leaves the colour unchanged (the crop's mean)
+};
+
 struct Quad {
   // Corners origin + a * edge_u + b * edge_v for a, b in [0, 1] (world frame, metres). Texture
   // columns run along edge_u, texture rows run against edge_v (edge_v points "up").
@@ -36,6 +46,7 @@ struct Quad {
   bool two_sided = true;          // false: visible only from the side edge_u x edge_v points to
   int object_id = 0;              // 0 = static scene, > 0 = dynamic object id (mask, boxes)
   const Sprite* sprite = nullptr; // cut-out texture (alpha test + relief) instead of `texture`
+  SurfaceDetail detail;           // sprites only
 };
 
 struct RenderOutput {
