@@ -288,6 +288,29 @@ def main():
             row.append(s)
         o.append(f"| {label(m)} | " + " | ".join(row) + " |")
 
+    # Dynamic keypoints no box covered (people the detector missed or cut, things they carry).
+    o.append("\n### Dynamic keypoints outside every box: per frame (median of runs) and the share dropped; "
+             "static keypoints dropped\n")
+    o.append(head)
+    o.append(sep)
+    for m in modes:
+        row = []
+        for p in presets:
+            c = cells.get((p, m))
+            if c is None or not c.ok:
+                row.append("-")
+                continue
+            frames = c.m(lambda r: find_key(r["stats"], {"frames"}))
+            outside = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_boxes"}))
+            dropped = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_dropped"}))
+            static = c.m(lambda r: find_key(r["stats"], {"static_drop_rate"}))
+            if outside is None:
+                row.append("-")
+                continue
+            share = f"{100 * dropped / outside:.1f} %" if outside and dropped is not None else "-"
+            row.append(f"{fmt(outside / max(1, frames or 1), 1)}, {share} dropped; static {fmt(static, 3)}")
+        o.append(f"| {label(m)} | " + " | ".join(row) + " |")
+
     # Time: medians over runs of each stage's per-frame median, and overall fps.
     stages = ["frame", "extraction", "detection", "screening", "tracking", "local_mapping"]
     o.append("\n### Time per frame (ms, median over frames, then over runs) and throughput\n")

@@ -30,6 +30,7 @@ const OptionTable<OrbOptions>& orbFields() {
       {"ORBextractor.nLevels", &O::n_levels, Range::closed(1, 32)},
       {"ORBextractor.iniThFAST", &O::ini_th_fast, Range::closed(1, 254)},
       {"ORBextractor.minThFAST", &O::min_th_fast, Range::closed(1, 254)},
+      {"ORBextractor.dynamicBoostMax", &O::dynamic_boost_max, Range::closed(1, 4)},
   };
   return table;
 }

@@ -5,12 +5,21 @@
 #include "yolo_slam/features/frame_builder.h"
 #include "yolo_slam/io/depth.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace yolo_slam {
 namespace frontend {
 
 namespace {
+
+// Budget steps: fine enough that a crowd gets what it needs, few enough to build up front.
+constexpr double kBoostStep = 0.25;
+// The budget grows once fewer than this share of nFeatures would stay after screening: two
+// walking people cost 15-25 % of the keypoints and tracking does well on the rest, so the
+// extra extraction time is spent on crowds, where half of the view can be people.
+constexpr double kKeepTarget = 0.75;
 
 // The depth as screening and tracking read it: a cleaned CV_32F copy (invalid readings 0).
 cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp) {
@@ -26,8 +35,23 @@ cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp)
 }  // namespace
 
 FrontEnd::FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOptions& screening)
-    : orb_(std::make_unique<features::OrbExtractor>(orb)),
-      screening_(std::make_unique<screening::ScreeningPipeline>(screening)) {}
+    : screening_(std::make_unique<screening::ScreeningPipeline>(screening)) {
+  orb.validate();
+  for (double boost = 1; boost <= orb.dynamic_boost_max + 1e-9; boost += kBoostStep) {
+    features::OrbOptions o = orb;
+    o.n_features = static_cast<int>(std::lround(orb.n_features * boost));
+    orb_.push_back(std::make_unique<features::OrbExtractor>(o));
+  }
+}
+
+size_t FrontEnd::budgetStep() const {
+  const double kept = 1.0 - dropped_share_.load();
+  if (kept <= 0) return orb_.size() - 1;
+  const double need = kKeepTarget / kept;
+  if (need <= 1) return 0;
+  const size_t step = static_cast<size_t>(std::lround((need - 1) / kBoostStep));
+  return std::min(step, orb_.size() - 1);
+}
 
 FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
@@ -35,13 +59,17 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
   const cv::Mat depth = checkedDepth(depth_m, image, stamp);
   FrontEndResult r;
   Stopwatch sw;
-  r.frame = features::buildFeatureFrame(*orb_, cam, image, depth, stamp);
+  const size_t step = budgetStep();
+  r.frame = features::buildFeatureFrame(*orb_[step], cam, image, depth, stamp);
   r.stats.extraction_ms = sw.ms();
+  r.stats.feature_budget = 1 + kBoostStep * step;
   sw.restart();
   screening::PipelineResult screened;
   {
     std::lock_guard<std::mutex> lk(mutex_);
     screened = screening_->process(r.frame, boxes, cam, depth, detector_ran);
+    const size_t n = r.frame.size();
+    dropped_share_ = n > 0 ? static_cast<float>(r.frame.countDynamic()) / n : 0.f;
   }
   r.stats.screening_ms = sw.ms();
   r.boxes = std::move(screened.boxes);
@@ -53,6 +81,7 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
 void FrontEnd::clear() {
   std::lock_guard<std::mutex> lk(mutex_);
   screening_->clear();
+  dropped_share_ = 0.f;
 }
 
 }  // namespace frontend

@@ -519,6 +519,8 @@ void to_json(Json& j, const ScreeningMetrics& m) {
            {"person_keypoints", m.person_total},
            {"person_dropped", m.person_dropped},
            {"person_recall", jsonRatio(m.person_dropped, m.person_total)},
+           {"object_keypoints", m.dynamic_total - m.person_total},
+           {"object_recall", jsonRatio(m.dynamic_dropped - m.person_dropped, m.dynamic_total - m.person_total)},
            {"static_in_boxes", m.static_in_boxes},
            {"kept", m.static_in_boxes_kept},
            {"static_retention", jsonRatio(m.static_in_boxes_kept, m.static_in_boxes)},

@@ -112,6 +112,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     stats_.keypoints += fe.stats.screening;
     stats_.temporal += fe.stats.temporal;
     stats_.boxes += box_counts;
+    stats_.feature_budget_sum += fe.stats.feature_budget;
   }
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
@@ -323,7 +324,8 @@ Json statsCountsJson(const SystemStats& s) {
               {"global_bundle_adjustments", s.global_bas},
               {"keypoints", s.keypoints},
               {"temporal", s.temporal},
-              {"boxes_screened", s.boxes}};
+              {"boxes_screened", s.boxes},
+              {"feature_budget_mean", jsonNumber(s.extraction_ms.empty() ? 0.0 : s.feature_budget_sum / s.extraction_ms.size())}};
 }
 
 std::vector<double> extractionPlusTrackingMs(const SystemStats& s) {

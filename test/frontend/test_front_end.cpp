@@ -109,3 +109,49 @@ TEST(FrontEnd, BadOptionsAreRejectedAtConstruction) {
   o.n_features = 0;
   EXPECT_THROW(frontend::FrontEnd(o, screening::ScreeningOptions()), Error);
 }
+
+namespace {
+
+// A box over the left `box_width` pixels of the image, its content 1.2 m away: screening drops
+// the keypoints in it (about half of them for a box over half of the image).
+size_t keypointsOfTheSecondFrame(double boost_max, double* budget, int box_width = 320) {
+  features::OrbOptions orb;
+  orb.dynamic_boost_max = boost_max;
+  screening::ScreeningOptions s;
+  s.mode = screening::DynamicMode::Detect;
+  frontend::FrontEnd fe(orb, s);
+  detection::Box half;
+  half.rect = cv::Rect2f(0, 0, static_cast<float>(box_width), 480);
+  half.score = 0.9f;
+  half.label = "person";
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(3.0f));
+  depth(cv::Rect(0, 0, box_width, 480)).setTo(1.2f);
+  const frontend::FrontEndResult first = fe.process(texture(7), depth, 0.0, {half}, CameraModel());
+  EXPECT_DOUBLE_EQ(first.stats.feature_budget, 1.0);  // nothing known yet
+  EXPECT_GT(first.frame.countDynamic(), first.frame.size() * box_width / 640 / 2);
+  const frontend::FrontEndResult second = fe.process(texture(8), depth, 0.033, {half}, CameraModel());
+  *budget = second.stats.feature_budget;
+  return second.frame.size();
+}
+
+}  // namespace
+
+TEST(FrontEnd, ExtractsMoreWhenScreeningDroppedMuchOfTheLastFrame) {
+  double fixed_budget = 0, boosted_budget = 0;
+  const size_t fixed = keypointsOfTheSecondFrame(1.0, &fixed_budget);
+  const size_t boosted = keypointsOfTheSecondFrame(2.0, &boosted_budget);
+  EXPECT_DOUBLE_EQ(fixed_budget, 1.0);
+  // About half was dropped: 1.5 times the keypoints, so that about 3/4 of nFeatures stay.
+  EXPECT_DOUBLE_EQ(boosted_budget, 1.5);
+  EXPECT_GT(boosted, fixed * 7 / 5);
+  // A small drop (an eighth of the view) keeps ORB-SLAM2's budget.
+  double small_budget = 0;
+  keypointsOfTheSecondFrame(2.0, &small_budget, 80);
+  EXPECT_DOUBLE_EQ(small_budget, 1.0);
+}
+
+TEST(FrontEnd, RejectsABoostBelowOne) {
+  features::OrbOptions orb;
+  orb.dynamic_boost_max = 0.5;
+  EXPECT_THROW(frontend::FrontEnd(orb, screening::ScreeningOptions()), Error);
+}

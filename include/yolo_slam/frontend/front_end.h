@@ -14,8 +14,10 @@
 
 #include <opencv2/core.hpp>
 
+#include <atomic>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 namespace yolo_slam {
 namespace frontend {
@@ -24,6 +26,7 @@ struct FrontEndStats {
   screening::ScreeningStats screening;  // Screener::screen
   screening::TemporalStats temporal;    // frame-to-frame evidence (zeros when it is off)
   double extraction_ms = 0, screening_ms = 0;
+  double feature_budget = 1;  // nFeatures times this were extracted (OrbOptions::dynamic_boost_max)
 };
 
 struct FrontEndResult {
@@ -48,11 +51,20 @@ class FrontEnd {
   // Forgets tracked boxes and the previous frame (a new sequence or a map reset).
   void clear();
 
-  const features::OrbExtractor& extractor() const { return *orb_; }
+  const features::OrbExtractor& extractor() const { return *orb_.front(); }
   const screening::Screener& screener() const { return screening_->screener(); }
 
  private:
-  std::unique_ptr<features::OrbExtractor> orb_;  // const after construction (thread-safe)
+  // The extractor for the next frame: the budget that would have left 3/4 of nFeatures of the
+  // last frame's keypoints after screening, to the nearest step, at most dynamic_boost_max.
+  size_t budgetStep() const;
+
+  // nFeatures times 1, 1 + kBoostStep, ... up to dynamic_boost_max; const after construction
+  // (thread-safe).
+  std::vector<std::unique_ptr<features::OrbExtractor>> orb_;
+  // Share of the last screened frame's keypoints that screening dropped (written under mutex_,
+  // read without it by the next frame's extraction).
+  std::atomic<float> dropped_share_{0.f};
   // Guards screening_ for one frame's whole process(); taken alone.
   std::mutex mutex_;
   std::unique_ptr<screening::ScreeningPipeline> screening_;

@@ -204,7 +204,8 @@ struct ScreeningMetrics {
 };
 // {"dynamic_keypoints", "dropped", "dynamic_recall", "dynamic_outside_boxes",
 //  "dynamic_outside_dropped", "dynamic_recall_in_boxes", "person_keypoints", "person_dropped",
-//  "person_recall", "static_in_boxes", "kept", "static_retention", "static_keypoints",
+//  "person_recall", "object_keypoints", "object_recall" (moving objects that are not people:
+//  a carried or moved box), "static_in_boxes", "kept", "static_retention", "static_keypoints",
 //  "static_dropped", "static_drop_rate"}; a ratio without a denominator is null.
 void to_json(Json& j, const ScreeningMetrics& m);
 

@@ -61,6 +61,7 @@ struct SystemStats {
   screening::ScreeningStats keypoints;  // Screener::screen
   screening::TemporalStats temporal;    // frame-to-frame evidence (propagateLabels, staticBoxVeto)
   BoxCounts boxes;
+  double feature_budget_sum = 0;  // per frame nFeatures multiples extracted (ORBextractor.dynamicBoostMax)
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
 };
 
@@ -69,7 +70,8 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 
 // The counts of stats.json, shared by System::statsJson and yolo_slam_run: frames, tracked,
 // lost, keyframes, keyframes_culled, map_points, map_resets, relocalizations, loops_closed,
-// global_bundle_adjustments, keypoints {...}, temporal {...}, boxes_screened {...}.
+// global_bundle_adjustments, keypoints {...}, temporal {...}, boxes_screened {...},
+// feature_budget_mean (nFeatures multiples extracted, mean over the frames).
 Json statsCountsJson(const SystemStats& s);
 // Per stage {"count", "median_ms", "mean_ms", "p95_ms"}: extraction, screening, tracking,
 // extraction_plus_tracking, local_mapping, detection, then `extra` stages measured by the caller.
