@@ -247,69 +247,58 @@ def main():
     o.append("| *paper YOLO-SLAM vs ORB-SLAM2 (Table 4)* | " +
              " | ".join(f"*{PAPER_T4_IMPROV[p]:.2f}*" if p in PAPER_T4_IMPROV else "-" for p in presets) + " |")
 
+    def mode_rows(cell_text, missing=lambda c: "-"):
+        """One row per mode, one cell per preset: cell_text(cell), missing(cell or None) without a run."""
+        o.append(head)
+        o.append(sep)
+        for m in modes:
+            row = []
+            for p in presets:
+                c = cells.get((p, m))
+                row.append(cell_text(c) if c is not None and c.ok else missing(c))
+            o.append(f"| {label(m)} | " + " | ".join(row) + " |")
+
     # Tracking health: an ATE over a few tracked poses means little.
     o.append("\n### Tracking: tracked / lost frames, trajectory poses, map resets, keyframes (medians)\n")
-    o.append(head)
-    o.append(sep)
-    for m in modes:
-        row = []
-        for p in presets:
-            c = cells.get((p, m))
-            if c is None or not c.ok:
-                row.append(c.fail_text() if c else "not run")
-                continue
-            row.append(f"{fmt(c.m(stat('tracked')), 0)} / {fmt(c.m(stat('lost')), 0)}, "
-                       f"{fmt(c.m(stat('trajectory_poses')), 0)} poses, {fmt(c.m(stat('map_resets')), 0)} resets, "
-                       f"{fmt(c.m(stat('keyframes')), 0)} KF")
-        o.append(f"| {label(m)} | " + " | ".join(row) + " |")
+    mode_rows(lambda c: f"{fmt(c.m(stat('tracked')), 0)} / {fmt(c.m(stat('lost')), 0)}, "
+                        f"{fmt(c.m(stat('trajectory_poses')), 0)} poses, {fmt(c.m(stat('map_resets')), 0)} resets, "
+                        f"{fmt(c.m(stat('keyframes')), 0)} KF",
+              missing=lambda c: c.fail_text() if c else "not run")
 
     # Screening keypoints and (when stats.json has them) recall / retention against the masks.
     o.append("\n### Screening: keypoints dropped per frame (median of runs), recall on people (on every moving "
              "object, where the sequence has others) / static retention\n")
-    o.append(head)
-    o.append(sep)
-    for m in modes:
-        row = []
-        for p in presets:
-            c = cells.get((p, m))
-            if c is None or not c.ok:
-                row.append("-")
-                continue
-            drop = c.m(lambda r: ((r["stats"] or {}).get("keypoints", {}).get("dropped", 0) /
-                                  max(1, (r["stats"] or {}).get("frames", 1))))
-            prec = c.m(lambda r: find_key(r["stats"], {"person_recall"}))
-            rec = c.m(lambda r: find_key(r["stats"], {"dynamic_recall", "recall"}))
-            ret = c.m(lambda r: find_key(r["stats"], {"static_retention", "retention"}))
-            s = f"{fmt(drop, 0)} dropped"
-            if prec is not None and rec is not None and abs(prec - rec) > 5e-4:
-                s += f", recall {fmt(prec, 3)} ({fmt(rec, 3)}), retention {fmt(ret, 3)}"
-            elif rec is not None or ret is not None:
-                s += f", recall {fmt(prec if prec is not None else rec, 3)}, retention {fmt(ret, 3)}"
-            row.append(s)
-        o.append(f"| {label(m)} | " + " | ".join(row) + " |")
+
+    def screening_text(c):
+        drop = c.m(lambda r: ((r["stats"] or {}).get("keypoints", {}).get("dropped", 0) /
+                              max(1, (r["stats"] or {}).get("frames", 1))))
+        prec = c.m(lambda r: find_key(r["stats"], {"person_recall"}))
+        rec = c.m(lambda r: find_key(r["stats"], {"dynamic_recall", "recall"}))
+        ret = c.m(lambda r: find_key(r["stats"], {"static_retention", "retention"}))
+        s = f"{fmt(drop, 0)} dropped"
+        if prec is not None and rec is not None and abs(prec - rec) > 5e-4:
+            s += f", recall {fmt(prec, 3)} ({fmt(rec, 3)}), retention {fmt(ret, 3)}"
+        elif rec is not None or ret is not None:
+            s += f", recall {fmt(prec if prec is not None else rec, 3)}, retention {fmt(ret, 3)}"
+        return s
+
+    mode_rows(screening_text)
 
     # Dynamic keypoints no box covered (people the detector missed or cut, things they carry).
     o.append("\n### Dynamic keypoints outside every box: per frame (median of runs) and the share dropped; "
              "static keypoints dropped\n")
-    o.append(head)
-    o.append(sep)
-    for m in modes:
-        row = []
-        for p in presets:
-            c = cells.get((p, m))
-            if c is None or not c.ok:
-                row.append("-")
-                continue
-            frames = c.m(lambda r: find_key(r["stats"], {"frames"}))
-            outside = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_boxes"}))
-            dropped = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_dropped"}))
-            static = c.m(lambda r: find_key(r["stats"], {"static_drop_rate"}))
-            if outside is None:
-                row.append("-")
-                continue
-            share = f"{100 * dropped / outside:.1f} %" if outside and dropped is not None else "-"
-            row.append(f"{fmt(outside / max(1, frames or 1), 1)}, {share} dropped; static {fmt(static, 3)}")
-        o.append(f"| {label(m)} | " + " | ".join(row) + " |")
+
+    def outside_text(c):
+        frames = c.m(lambda r: find_key(r["stats"], {"frames"}))
+        outside = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_boxes"}))
+        dropped = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_dropped"}))
+        static = c.m(lambda r: find_key(r["stats"], {"static_drop_rate"}))
+        if outside is None:
+            return "-"
+        share = f"{100 * dropped / outside:.1f} %" if outside and dropped is not None else "-"
+        return f"{fmt(outside / max(1, frames or 1), 1)}, {share} dropped; static {fmt(static, 3)}"
+
+    mode_rows(outside_text)
 
     # Time: medians over runs of each stage's per-frame median, and overall fps.
     stages = ["frame", "extraction", "detection", "screening", "tracking", "local_mapping"]

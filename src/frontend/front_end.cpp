@@ -16,10 +16,10 @@ namespace {
 
 // Budget steps: fine enough that a crowd gets what it needs, few enough to build up front.
 constexpr double kBoostStep = 0.25;
-// The budget grows once fewer than this share of nFeatures would stay after screening: two
-// walking people cost 15-25 % of the keypoints and tracking does well on the rest, so the
-// extra extraction time is spent on crowds, where half of the view can be people.
-constexpr double kKeepTarget = 0.75;
+// The budget grows once fewer than this share of the keypoints stayed after screening: two
+// walking people cost 15-25 % of them and tracking does well on the rest, so the extra
+// extraction time goes to crowds, where half of the view can be people.
+constexpr double kBoostBelowKept = 0.75;
 
 // The depth as screening and tracking read it: a cleaned CV_32F copy (invalid readings 0).
 cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp) {
@@ -47,19 +47,16 @@ FrontEnd::FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOp
 size_t FrontEnd::budgetStep() const {
   const double kept = 1.0 - dropped_share_.load();
   if (kept <= 0) return orb_.size() - 1;
-  const double need = kKeepTarget / kept;
-  if (need <= 1) return 0;
-  const size_t step = static_cast<size_t>(std::lround((need - 1) / kBoostStep));
+  if (kept >= kBoostBelowKept) return 0;
+  // The budget that would have left nFeatures, rounded up to a step.
+  const size_t step = static_cast<size_t>(std::ceil((1.0 / kept - 1) / kBoostStep - 1e-9));
   return std::min(step, orb_.size() - 1);
 }
 
-FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                                 const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
-  if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
-  const cv::Mat depth = checkedDepth(depth_m, image, stamp);
+FrontEndResult FrontEnd::extractAndScreen(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
+                                          const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
   FrontEndResult r;
   Stopwatch sw;
-  const size_t step = budgetStep();
   r.frame = features::buildFeatureFrame(*orb_[step], cam, image, depth, stamp);
   r.stats.extraction_ms = sw.ms();
   r.stats.feature_budget = 1 + kBoostStep * step;
@@ -78,10 +75,30 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
   return r;
 }
 
+FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                                 const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
+  if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
+  const cv::Mat depth = checkedDepth(depth_m, image, stamp);
+  const size_t step = budgetStep();
+  FrontEndResult r = extractAndScreen(step, image, depth, stamp, boxes, cam, detector_ran);
+  // The first frame of a stream has no last frame to size its budget by, and SLAM initialises
+  // on it: when it needed more, it is extracted again (screening has seen nothing else yet).
+  const size_t needed = budgetStep();
+  if (fresh_.exchange(false) && needed > step) {
+    const double first_ms = r.stats.extraction_ms + r.stats.screening_ms;
+    clear();
+    fresh_ = false;
+    r = extractAndScreen(needed, image, depth, stamp, boxes, cam, detector_ran);
+    r.stats.extraction_ms += first_ms;
+  }
+  return r;
+}
+
 void FrontEnd::clear() {
   std::lock_guard<std::mutex> lk(mutex_);
   screening_->clear();
   dropped_share_ = 0.f;
+  fresh_ = true;
 }
 
 }  // namespace frontend

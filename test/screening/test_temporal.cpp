@@ -96,6 +96,7 @@ TemporalOptions propagation() {
   TemporalOptions o;
   o.propagate_labels = true;
   o.static_box_veto = false;
+  o.motion_screening = false;
   return o;
 }
 
@@ -202,6 +203,7 @@ VetoScene vetoScene(TemporalScreening& ts) {
 TemporalOptions vetoOnly() {
   TemporalOptions o;
   o.static_box_veto = true;
+  o.motion_screening = false;
   return o;
 }
 

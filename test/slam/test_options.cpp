@@ -43,6 +43,7 @@ ORBextractor.scaleFactor: 1.25
 ORBextractor.nLevels: 6
 ORBextractor.iniThFAST: 18
 ORBextractor.minThFAST: 6
+ORBextractor.dynamicBoostMax: 1.5
 Detector.model: "/tmp/ys_model"
 Detector.extraModels: [ "/tmp/ys_extra_a", "/tmp/ys_extra_b" ]
 Detector.inputWidth: 320
@@ -88,6 +89,13 @@ Screening.temporalRadius: 25.5
 Screening.temporalMaxHamming: 40
 Screening.temporalMaxDepthChange: 0.25
 Screening.temporalStaticTolerance: 2.5
+Screening.motionScreening: 0
+Screening.motionMinResidual: 7.5
+Screening.motionSupportRadius: 35
+Screening.motionMinSupport: 4
+Screening.motionMinShare: 0.625
+Screening.motionSupportDepth: 0.25
+Screening.motionFlowTolerance: 3.5
 Tracking.initMinKeyPoints: 400
 Tracking.initMinDepthPoints: 80
 Tracking.motionWindow: 12
@@ -177,6 +185,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   const features::OrbOptions& orb = sys.orb;
   EXPECT_EQ(std::tie(orb.n_features, orb.scale_factor, orb.n_levels, orb.ini_th_fast, orb.min_th_fast),
             std::make_tuple(1500, 1.25, 6, 18, 6));
+  EXPECT_DOUBLE_EQ(orb.dynamic_boost_max, 1.5);
   EXPECT_TRUE(sys.sequential);
 
   const detection::DetectorOptions d = detection::DetectorOptions::load(cfg);
@@ -209,6 +218,10 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(m.propagate_labels, m.propagate_max_age), std::make_tuple(true, 2));
   EXPECT_EQ(std::tie(m.radius_px, m.max_hamming, m.max_depth_change_m, m.static_tolerance_px),
             std::make_tuple(25.5, 40, 0.25, 2.5));
+  EXPECT_EQ(std::tie(m.motion_screening, m.motion_min_residual_px, m.motion_support_radius_px, m.motion_min_support),
+            std::make_tuple(false, 7.5, 35.0, 4));
+  EXPECT_EQ(std::tie(m.motion_min_share, m.motion_support_depth_m, m.motion_flow_tolerance_px),
+            std::make_tuple(0.625, 0.25, 3.5));
 
   const slam::TrackingOptions& k = sys.slam.tracking;
   EXPECT_EQ(std::tie(k.init_min_keypoints, k.init_min_depth_points, k.motion_window, k.local_window, k.min_inliers),

@@ -20,8 +20,8 @@ struct OrbOptions {
   int ini_th_fast = 20;       // ORBextractor.iniThFAST: FAST threshold tried first in a cell
   int min_th_fast = 7;        // ORBextractor.minThFAST: fallback when a cell has no corner
   // ORBextractor.dynamicBoostMax: when screening dropped more than a quarter of the last frame's
-  // keypoints, the front end extracts up to this many times nFeatures so that about 3/4 of
-  // nFeatures stay for SLAM (1: ORB-SLAM2's fixed budget). Crowds otherwise leave too few
+  // keypoints, the front end extracts up to this many times nFeatures so that about nFeatures
+  // stay for SLAM (1: ORB-SLAM2's fixed budget). Crowds otherwise leave too few
   // static points to initialise and track.
   double dynamic_boost_max = 2.0;
 

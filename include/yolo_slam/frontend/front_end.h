@@ -55,9 +55,13 @@ class FrontEnd {
   const screening::Screener& screener() const { return screening_->screener(); }
 
  private:
-  // The extractor for the next frame: the budget that would have left 3/4 of nFeatures of the
-  // last frame's keypoints after screening, to the nearest step, at most dynamic_boost_max.
+  // The extractor for the next frame: when screening dropped over a quarter of the last
+  // frame's keypoints, the budget that would have left nFeatures (rounded up to a step, at
+  // most dynamic_boost_max); else nFeatures.
   size_t budgetStep() const;
+  // Extraction with orb_[step], then screening (under mutex_); records the dropped share.
+  FrontEndResult extractAndScreen(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
+                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran);
 
   // nFeatures times 1, 1 + kBoostStep, ... up to dynamic_boost_max; const after construction
   // (thread-safe).
@@ -65,6 +69,7 @@ class FrontEnd {
   // Share of the last screened frame's keypoints that screening dropped (written under mutex_,
   // read without it by the next frame's extraction).
   std::atomic<float> dropped_share_{0.f};
+  std::atomic<bool> fresh_{true};  // no frame since construction or clear()
   // Guards screening_ for one frame's whole process(); taken alone.
   std::mutex mutex_;
   std::unique_ptr<screening::ScreeningPipeline> screening_;

@@ -3,7 +3,7 @@
 // previous frame (ORB descriptor near its old position); the camera motion between the frames is
 // estimated from the matched static keypoints with depth (3D-2D PnP RANSAC); a match that lands
 // within static_tolerance_px of where its point would be if it were static is "static-consistent".
-// Two uses, each with its own switch:
+// Three uses, each with its own switch:
 //
 // - Label propagation (Screening.propagateLabels): a keypoint matched to a dynamic keypoint of
 //   the previous frame that MOVED (not static-consistent) is dynamic too, box or no box. Most
@@ -19,12 +19,13 @@
 //   (sitting_static 4.9 -> 53 mm without the score bound); but the detector is sure of them
 //   (scores 0.97-1.0 there) and unsure of its false positives (static_xyz: 95 % below 0.8).
 //
-// - Motion screening (Screening.motionScreening): class-agnostic. A keypoint that MOVED by at
-//   least motionMinResidual pixels against the camera motion, with at least motionMinSupport
-//   moved neighbours within motionSupportRadius at a similar depth that are the majority
-//   (motionMinShare) of the tested keypoints there, is dynamic, box or no box: people the
-//   detector missed or cut, and the things they carry. The support rule keeps isolated false
-//   matches in the static scene from being dropped.
+// - Motion screening (Screening.motionScreening, on by default): class-agnostic. A keypoint
+//   that MOVED by at least motionMinResidual pixels against the camera motion, that no
+//   lookalike keypoint of the previous frame explains as static (repeated texture), and that
+//   has at least motionMinSupport moved neighbours within motionSupportRadius at a similar
+//   depth, moving alike (motionFlowTolerance) and the majority (motionMinShare) of the tested
+//   keypoints there, is dynamic, box or no box: people the detector missed or cut, and the
+//   things they carry. Isolated or incoherent "moves" (false matches) drop nothing.
 //
 // Per frame, after Screener::screen:  temporal.apply(frame, boxes, cam);
 #include "yolo_slam/common/camera.h"
@@ -62,7 +63,7 @@ struct TemporalOptions {
   // position predicted for a static point is static.
   double static_tolerance_px = 3;
 
-  bool motion_screening = false;
+  bool motion_screening = true;
   // A moved keypoint counts only this far (pixels at level 0, times the level's scale) from
   // its static position: twice the static tolerance, so that the band between stays untested.
   double motion_min_residual_px = 6;
