@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <random>
 
@@ -54,6 +55,8 @@ const OptionTable<ScreeningOptions>& screeningFields() {
       {"Screening.silhouetteRadius", &O::silhouette_radius_px, Range::atLeast(0)},
       {"Screening.dilationDepthOnly", &O::dilation_depth_only},
       {"Screening.rejectFlatBoxes", &O::reject_flat_boxes},
+      {"Screening.occlusionRule", &O::occlusion_rule},
+      {"Screening.occlusionMaxIou", &O::occlusion_max_iou, Range::fraction()},
       {"Screening.flatBoxFraction", &O::flat_box_fraction, Range::fraction()},
       {"Screening.flatBoxTolerance", &O::flat_box_tolerance, Range::positive()},
       {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
@@ -388,13 +391,12 @@ void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
   }
 }
 
-// Screens one region: its person set is dropped, then the silhouette and no-depth rules, unless
-// the flat-box rule leaves the box alone.
-void screenRegion(const Screener& s, const features::FeatureFrame& frame, Region& r,
-                  const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
-                  std::vector<uint8_t>& drop, ScreeningStats& st) {
+// Marks one region whose person set findPerson found: the set is dropped, then the silhouette
+// and no-depth rules, unless the flat-box rule leaves the box alone.
+void markRegion(const Screener& s, const features::FeatureFrame& frame, const Region& r,
+                const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                std::vector<uint8_t>& drop, ScreeningStats& st) {
   const ScreeningOptions& o = s.options();
-  st.iterations += findPerson(s, frame, r);
   if (r.box && o.reject_flat_boxes && isFlatBox(o, frame, r, boxes)) {
     ++st.flat_boxes;
     return;  // a picture or static surface: nothing in this box is dropped
@@ -406,21 +408,76 @@ void screenRegion(const Screener& s, const features::FeatureFrame& frame, Region
   markNoDepth(o, frame, r, drop);
 }
 
+// The keypoints of a region's person set.
+std::vector<int> personSet(const Region& r) {
+  std::vector<int> out;
+  for (size_t m = 0; m < r.member.size(); ++m)
+    if (r.member[m]) out.push_back(r.with_depth[m]);
+  return out;
+}
+
+// Share of a region's keypoints with depth that are its person.
+double personFill(const Region& r) {
+  return r.with_depth.empty() ? 0.0 : static_cast<double>(personSet(r).size()) / r.with_depth.size();
+}
+
+float iou(const cv::Rect2f& a, const cv::Rect2f& b) {
+  const float inter = (a & b).area();
+  const float uni = a.area() + b.area() - inter;
+  return uni > 0 ? inter / uni : 0.f;
+}
+
+// Share of a person set that another region claimed as its own person, above which the set is
+// taken to be that region's person seen through this box.
+constexpr double kClaimedShare = 0.5;
+
+// The occlusion rule: a box whose person set is mostly the person of another overlapping box
+// (not a duplicate detection) that its person fills better is screened again without them.
+void resolveOcclusions(const Screener& s, const features::FeatureFrame& frame, const detection::Boxes& boxes,
+                       std::vector<Region>& regions, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  std::vector<std::vector<int>> sets;
+  std::vector<double> fill;
+  for (const Region& r : regions) {
+    std::vector<int> set = personSet(r);
+    std::sort(set.begin(), set.end());
+    sets.push_back(std::move(set));
+    fill.push_back(personFill(r));
+  }
+  for (size_t b = 0; b < regions.size(); ++b) {
+    if (sets[b].empty()) continue;
+    for (size_t c = 0; c < regions.size(); ++c) {
+      if (c == b || fill[c] < fill[b] || iou(boxes[b].rect, boxes[c].rect) > o.occlusion_max_iou) continue;
+      std::vector<int> shared;
+      std::set_intersection(sets[b].begin(), sets[b].end(), sets[c].begin(), sets[c].end(),
+                            std::back_inserter(shared));
+      if (shared.size() < kClaimedShare * sets[b].size()) continue;
+      Region& r = regions[b];
+      r.idx.erase(std::remove_if(r.idx.begin(), r.idx.end(),
+                                 [&](int i) { return std::binary_search(sets[c].begin(), sets[c].end(), i); }),
+                  r.idx.end());
+      st.iterations += findPerson(s, frame, r);
+      ++st.occluded_boxes;
+      break;
+    }
+  }
+}
+
 // Box modes: the keypoints of each dilated box (in_any) are dropped (detect) or screened.
 void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
                  const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
                  std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop, ScreeningStats& st) {
   const ScreeningOptions& o = s.options();
-  Region r;
-  r.idx.reserve(frame.keypoints.size());
+  std::vector<cv::Rect2f> dilated(boxes.size());
+  std::vector<Region> regions(boxes.size());
   for (size_t b = 0; b < boxes.size(); ++b) {
-    const cv::Rect2f dilated = dilate(boxes[b].rect, o.box_dilation);
+    dilated[b] = dilate(boxes[b].rect, o.box_dilation);
+    Region& r = regions[b];
     r.index = static_cast<unsigned>(b);
-    r.box = &dilated;
+    r.box = &dilated[b];
     r.core = o.dilation_depth_only ? &boxes[b].rect : nullptr;
-    r.idx.clear();
     for (size_t i = 0; i < frame.keypoints.size(); ++i) {
-      if (inside(dilated, frame.keypoints[i].pt)) {
+      if (inside(dilated[b], frame.keypoints[i].pt)) {
         r.idx.push_back(static_cast<int>(i));
         in_any[i] = 1;
       }
@@ -428,9 +485,12 @@ void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
     if (o.mode == DynamicMode::Detect) {
       for (int i : r.idx) drop[i] = 1;
     } else {
-      screenRegion(s, frame, r, boxes, silhouette_depth, drop, st);
+      st.iterations += findPerson(s, frame, r);
     }
   }
+  if (o.mode == DynamicMode::Detect) return;
+  if (o.occlusion_rule && regions.size() > 1) resolveOcclusions(s, frame, boxes, regions, st);
+  for (const Region& r : regions) markRegion(s, frame, r, boxes, silhouette_depth, drop, st);
 }
 
 // Writes the drops of the keypoints in a region into frame.dynamic and counts them.
@@ -465,7 +525,8 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
       Region r;
       for (size_t i = 0; i < n; ++i) r.idx.push_back(static_cast<int>(i));
       std::fill(in_any.begin(), in_any.end(), 1);
-      screenRegion(*this, frame, r, boxes, silhouette_depth, drop, st);
+      st.iterations += findPerson(*this, frame, r);
+      markRegion(*this, frame, r, boxes, silhouette_depth, drop, st);
     } else {
       screenBoxes(*this, frame, boxes, silhouette_depth, in_any, drop, st);
     }
@@ -537,13 +598,15 @@ ScreeningStats& ScreeningStats::operator+=(const ScreeningStats& o) {
   ms += o.ms;
   flat_boxes += o.flat_boxes;
   silhouette += o.silhouette;
+  occluded_boxes += o.occluded_boxes;
   return *this;
 }
 
 void to_json(Json& j, const ScreeningStats& s) {
   j = Json{{"in_boxes", s.in_boxes},     {"kept", s.kept},
            {"dropped", s.dropped},       {"silhouette", s.silhouette},
-           {"flat_boxes", s.flat_boxes}, {"iterations", s.iterations}};
+           {"flat_boxes", s.flat_boxes}, {"occluded_boxes", s.occluded_boxes},
+           {"iterations", s.iterations}};
 }
 
 ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,

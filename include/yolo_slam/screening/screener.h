@@ -92,6 +92,13 @@ struct ScreeningOptions {
   // in front of one: nothing in it is dropped. Keys Screening.rejectFlatBoxes,
   // flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing (fraction of the box size per side).
   bool reject_flat_boxes = false;
+  // Occlusion rule (beyond the paper): when the person set found in a box is mostly the person
+  // set of another, overlapping box that its person fills better (a nearer person standing in
+  // front of this box's person), this box is screened again without those keypoints, so that
+  // the person behind is found too. Boxes overlapping by more than occlusion_max_iou are one
+  // person detected twice and are left as they are. Screening.occlusionRule, occlusionMaxIou.
+  bool occlusion_rule = true;
+  double occlusion_max_iou = 0.5;
   double flat_box_fraction = 0.4;
   double flat_box_tolerance = 0.01;
   double flat_box_ring = 0.25;
@@ -108,7 +115,8 @@ struct ScreeningOptions {
   // Reads Screening.mode, variant, varianceThreshold (m^2), probability, maxIterations, seed,
   // noDepth (dynamic | static | nearest | near-dynamic), noDepthRadius (px), silhouetteRadius
   // (px), boxDilation, growRadius (px), growDepth (m), clusterMinFraction, dilationDepthOnly,
-  // rejectFlatBoxes, flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing, then the keys of
+  // rejectFlatBoxes, flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing, occlusionRule,
+  // occlusionMaxIou, then the keys of
   // `tracker` and `temporal`. Invalid values throw yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // The loader's rules, for options set in code (tracker and temporal included); throws
@@ -124,9 +132,11 @@ struct ScreeningStats {
   double ms = 0;       // wall time of screen()
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
   int silhouette = 0;  // of dropped, keypoints the silhouette rule dropped
+  int occluded_boxes = 0;  // boxes screened again by the occlusion rule
   ScreeningStats& operator+=(const ScreeningStats& o);
 };
-// {"in_boxes", "kept", "dropped", "silhouette", "flat_boxes", "iterations"} (ms is timed apart).
+// {"in_boxes", "kept", "dropped", "silhouette", "flat_boxes", "occluded_boxes", "iterations"}
+// (ms is timed apart).
 void to_json(Json& j, const ScreeningStats& s);
 
 // The box grown by fraction f of its width/height on each side (Screening.boxDilation).
