@@ -1,6 +1,7 @@
 // Map files (slam/map_file.h): a map of the first frames of a synthetic static_xyz run is
-// saved, loaded and saved again (identical bytes, same map), bad files are refused with an
-// error naming the file while the running map stays as it was, and a new System in
+// saved, loaded and saved again (identical bytes, same map), bad files (missing, truncated,
+// corrupted, another version, vocabulary, camera or ORB pyramid) are refused with an error
+// naming the file while the running map stays as it was, and a new System in
 // localization mode relocalises in a loaded map and tracks later frames of the run.
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -29,6 +30,7 @@ constexpr size_t kMappedFrames = 80;           // frames 0..79 build the map
 constexpr size_t kLaterFirst = 80, kLaterLast = 110;  // frames fed to the loaded map
 constexpr size_t kFramesBeforeBadLoad = 5;     // a system with a map of its own
 constexpr double kMaxPoseError = 0.05;         // metres, relocalised pose against ground truth
+constexpr int kOtherPyramidLevels = 6;         // the map is built with the default 8
 // Portable binary header: 1 byte endianness flag, 8 bytes magic, then the 4-byte version.
 constexpr size_t kVersionOffset = 9;
 
@@ -194,9 +196,13 @@ TEST_F(SlamMapFile, DamagedFilesAreRefusedAndTheMapStays) {
   version[kVersionOffset] ^= 0x40;
   writeBytes(path("version.ysmap"), version);
   expectRefused(sys, path("version.ysmap"), "format version");
+  writeBytes(path("trailing.ysmap"), good + "x");
+  expectRefused(sys, path("trailing.ysmap"), "corrupted");
+  writeBytes(path("other.ysmap"), std::string(good.size(), 'x'));
+  expectRefused(sys, path("other.ysmap"), "not a yolo_slam map file");
 }
 
-TEST_F(SlamMapFile, AnotherVocabularyOrCameraIsRefused) {
+TEST_F(SlamMapFile, AnotherVocabularyCameraOrPyramidIsRefused) {
   // A two-word vocabulary: a root and two leaves.
   auto other_voc = vocabulary::Vocabulary::fromNodes(2, 1, vocabulary::Weighting::TfIdf, vocabulary::Scoring::L1,
                                                      {0, 0, 0}, std::vector<uint8_t>(3 * 32, 0x0f), {0, 1, 1}, {});
@@ -212,6 +218,11 @@ TEST_F(SlamMapFile, AnotherVocabularyOrCameraIsRefused) {
   slam::System cam_sys(cam, testOptions(), vocab());
   feed(cam_sys, 0, kFramesBeforeBadLoad - 1);
   expectRefused(cam_sys, file(), "another camera");
+
+  slam::SystemOptions pyramid = testOptions();
+  pyramid.orb.n_levels = kOtherPyramidLevels;
+  slam::System orb_sys(generator().camera(), pyramid, vocab());
+  expectRefused(orb_sys, file(), "ORBextractor.nLevels");
 }
 
 TEST_F(SlamMapFile, LocalizationRelocalisesInALoadedMap) {
