@@ -249,3 +249,36 @@ TEST_F(SlamMapFile, LocalizationRelocalisesInALoadedMap) {
 }
 
 }  // namespace
+
+// Threaded back end with loop closing, mapping on: the loaded map is extended, and the extended
+// map saves and loads again.
+TEST(SlamMapFileThreaded, MappingContinuesInALoadedMap) {
+  test::TempDir dir;
+  const std::string first = dir.path() + "/first.ysmap", second = dir.path() + "/second.ysmap";
+  slam::SystemOptions opt = testOptions();
+  opt.sequential = false;
+  opt.slam.loop.enabled = true;
+  slam::MapFileInfo built;
+  {
+    slam::System builder(generator().camera(), opt, vocab());
+    feed(builder, 0, kMappedFrames - 1);
+    builder.waitForLoopClosing();
+    built = builder.saveMap(first);
+  }
+  slam::System sys(generator().camera(), opt, vocab());
+  sys.loadMap(first);
+  int tracked = 0;
+  for (size_t i = kLaterFirst; i <= kLaterLast; ++i) {
+    const sim::SynthFrame f = generator().frame(i);
+    tracked += sys.trackRgbd(f.bgr, f.depth, f.rgb_stamp, {}).state == slam::TrackingState::Ok ? 1 : 0;
+  }
+  sys.waitForLoopClosing();
+  EXPECT_GE(sys.stats().relocalizations, 1u);
+  EXPECT_GE(tracked, static_cast<int>(kLaterLast - kLaterFirst) - 2);
+  const slam::MapFileInfo extended = sys.saveMap(second);
+  EXPECT_GE(extended.keyframes, built.keyframes);
+  slam::System again(generator().camera(), opt, vocab());
+  EXPECT_EQ(again.loadMap(second).keyframes, extended.keyframes);
+  std::printf("loaded map of %zu keyframes extended to %zu while tracking %d frames\n", built.keyframes,
+              extended.keyframes, tracked);
+}
