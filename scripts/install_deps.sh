@@ -26,6 +26,7 @@ DEPENDENCIES='
   libceres-dev:       libceres-dev
   libopenni2-dev:     libopenni2-dev
   nlohmann-json-dev:  nlohmann-json3-dev
+  libcereal-dev:      libcereal-dev
   message_generation: ros-message-generation
   message_runtime:    ros-message-runtime
   roslaunch:          python3-roslaunch rosbash

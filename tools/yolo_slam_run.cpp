@@ -1,6 +1,7 @@
 // yolo_slam_run: the offline runner (ORB-SLAM2's rgbd_tum equivalent). Reads a TUM RGB-D
 // folder, runs detection (own thread, one frame ahead), screening and SLAM frame by frame and
-// writes CameraTrajectory.txt, KeyFrameTrajectory.txt and stats.json.
+// writes CameraTrajectory.txt, KeyFrameTrajectory.txt and stats.json; optionally starts in a map
+// loaded from a file and saves the map at the end (slam/map_file.h).
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -58,6 +59,7 @@ const char* kUsage =
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
     "                     [--static-box-veto on|off] [--sequential] [--set KEY=VALUE ...]\n"
+    "                     [--load-map FILE] [--save-map FILE] [--localization]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -108,15 +110,22 @@ const char* kUsage =
     "                     whose dropped keypoints all sit where static points would be\n"
     "  --sequential       --set System.sequential=1: local mapping and loop closing run after\n"
     "                     each frame in the main thread, so a run repeats bit for bit\n"
+    "  --load-map FILE    start in the map saved in FILE (by --save-map, with the same camera,\n"
+    "                     ORB pyramid and vocabulary): tracking starts lost and relocalises, so\n"
+    "                     the trajectory is in the loaded map's frame\n"
+    "  --save-map FILE    write the map to FILE at the end (also after Ctrl-C); stats.json\n"
+    "                     \"map_file\" has its size and the save and load times\n"
+    "  --localization     track against the map without adding keyframes or points (with\n"
+    "                     --load-map: localisation in a prebuilt map)\n"
     "  -h, --help         this text\n";
 
 struct Args {
-  std::string sequence, config, out, model, vocabulary, boxes_file;
+  std::string sequence, config, out, model, vocabulary, boxes_file, load_map, save_map;
   // Settings overrides in command-line order (--set and the flags that stand for a key).
   std::vector<std::string> overrides;
   long max_frames = -1;
   bool realtime = false, camera_rate = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
-       single_model = false;
+       single_model = false, localization = false;
 };
 
 // "on"/"off" of a flag standing for a boolean key, as the key's override.
@@ -136,6 +145,14 @@ long positiveLong(const std::string& flag, const std::string& v) {
   const long n = std::strtol(v.c_str(), &end, 10);
   if (!end || *end || n <= 0) throw Error(flag + " must be a positive integer (got '" + v + "')");
   return n;
+}
+
+// --save-map writes at the end of the run: a folder that does not exist should fail now, not
+// after the whole sequence.
+void checkSaveMapFolder(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, std::max<size_t>(slash, 1));
+  if (!dirExists(dir)) throw Error(path + ": --save-map folder " + dir + " does not exist; create it first");
 }
 
 // Fills in the settings file and the vocabulary the user did not name.
@@ -183,6 +200,9 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--static-box-veto") a.overrides.push_back(onOffOverride(s, "Screening.staticBoxVeto", need(i, s)));
     else if (s == "--track-boxes") a.overrides.push_back(onOffOverride(s, "Screening.trackBoxes", need(i, s)));
     else if (s == "--max-frames") a.max_frames = positiveLong(s, need(i, s));
+    else if (s == "--load-map") a.load_map = need(i, s);
+    else if (s == "--save-map") a.save_map = need(i, s);
+    else if (s == "--localization") a.localization = true;
     else if (s == "-h" || s == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
@@ -195,6 +215,7 @@ Args parseArgs(int argc, char** argv) {
   if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
   if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
   if (a.realtime && a.camera_rate) throw Error("--realtime and --camera-rate exclude each other");
+  if (!a.save_map.empty()) checkSaveMapFolder(a.save_map);
   resolveDefaultFiles(a);
   return a;
 }
@@ -597,8 +618,26 @@ Json detectionJson(const RunSetup& setup, const LoopResult& res) {
               {"results_too_old", res.boxes_expired}};
 }
 
+// The map files of a run (--load-map, --save-map), for stats.json "map_file".
+struct MapFiles {
+  std::optional<slam::MapFileInfo> loaded, saved;
+};
+
+Json mapFileInfoJson(const std::string& path, const std::optional<slam::MapFileInfo>& info) {
+  if (!info) return nullptr;
+  return Json{{"path", path},           {"bytes", info->bytes},
+              {"keyframes", info->keyframes}, {"map_points", info->map_points},
+              {"ms", jsonNumber(info->ms)}};
+}
+
+Json mapFilesJson(const Args& args, const MapFiles& maps) {
+  return Json{{"localization", args.localization},
+              {"loaded", mapFileInfoJson(args.load_map, maps.loaded)},
+              {"saved", mapFileInfoJson(args.save_map, maps.saved)}};
+}
+
 Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res, size_t poses,
-                  const AteSummary& ate, const slam::SystemStats& s) {
+                  const AteSummary& ate, const slam::SystemStats& s, const MapFiles& maps) {
   const screening::Stages& st = setup.stages;
   Json j{{"sequence", args.sequence},
          {"config", args.config},
@@ -621,6 +660,7 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res
   j["screening_metrics"] = res.metrics.json();
   j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}, {"latency", res.latency_ms}});
   j["detection"] = detectionJson(setup, res);
+  j["map_file"] = mapFilesJson(args, maps);
   if (args.camera_rate)
     j["camera"] = Json{{"offered", res.camera_offered},
                        {"processed", res.processed + res.skipped},
@@ -664,6 +704,14 @@ void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary
 int run(const Args& args) {
   RunSetup setup = setUp(args);
   slam::System system(setup.cam, setup.options, setup.voc);
+  MapFiles maps;
+  // Localization first: local mapping is paused before the loaded map can get a keyframe.
+  if (args.localization) system.setLocalizationOnly(true);
+  if (!args.load_map.empty()) {
+    maps.loaded = system.loadMap(args.load_map);
+    std::fprintf(stderr, "yolo_slam_run: loaded map %s: %zu keyframes, %zu points in %.0f ms\n", args.load_map.c_str(),
+                 maps.loaded->keyframes, maps.loaded->map_points, maps.loaded->ms);
+  }
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   // Printed once the handlers are in place (the Ctrl-C test waits for this line).
@@ -681,9 +729,15 @@ int run(const Args& args) {
   const Trajectory traj = system.cameraTrajectory();
   io::writeTrajectory(joinPath(args.out, "CameraTrajectory.txt"), traj);
   io::writeTrajectory(joinPath(args.out, "KeyFrameTrajectory.txt"), system.keyframeTrajectory());
+  if (!args.save_map.empty()) {
+    maps.saved = system.saveMap(args.save_map);
+    std::printf("saved map %s: %zu keyframes, %zu points, %zu bytes in %.0f ms\n", args.save_map.c_str(),
+                maps.saved->keyframes, maps.saved->map_points, maps.saved->bytes, maps.saved->ms);
+  }
   const AteSummary ate = ateOf(setup.seq, traj);
   const slam::SystemStats s = system.stats();
-  io::writeFileAtomic(joinPath(args.out, "stats.json"), dumpJson(runStatsJson(args, setup, res, traj.size(), ate, s)));
+  io::writeFileAtomic(joinPath(args.out, "stats.json"),
+                      dumpJson(runStatsJson(args, setup, res, traj.size(), ate, s, maps)));
   printSummary(setup, res, ate, s);
   std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
   return g_stop ? 130 : 0;

@@ -160,6 +160,18 @@ void Map::clear() {
   if (kfdb_) kfdb_->clear();
 }
 
+void Map::adopt(Map& other) {
+  clear();
+  keyframes_.swap(other.keyframes_);
+  points_.swap(other.points_);
+  origin_.swap(other.origin_);
+  restoreIdCounters(other.next_kf_id_.load(), other.next_point_id_.load());
+  if (other.kfdb_) other.kfdb_->clear();
+  if (!kfdb_) return;
+  for (const auto& kf : keyframes_)
+    if (!kf->f.bow.empty()) kfdb_->add(kf->id, kf->f.bow.bow);
+}
+
 namespace {
 // ORB-SLAM2 DetectRelocalizationCandidates / DetectLoopCandidates: a hit is grouped with its best
 // covisibles; groups scoring above this share of the best group's score survive.

@@ -158,9 +158,7 @@ void System::runBackEndInline() {
   if (loop_closer_) loop_closer_->processQueued();
 }
 
-void System::resetInternal(bool keep_trajectory) {
-  // Caller holds track_mutex_. Loop closing (and its global BA) is stopped and local mapping
-  // parked before the map is cleared.
+void System::parkBackEnd() {
   if (loop_closer_) {
     loop_closer_->stop();
     loop_closer_->clear();
@@ -168,6 +166,16 @@ void System::resetInternal(bool keep_trajectory) {
   mapper_->pause();
   mapper_->waitUntilPaused();
   mapper_->clear();
+}
+
+void System::resumeBackEnd() {
+  if (!localization_only_.load()) mapper_->resume();
+  if (loop_closer_) loop_closer_->start();
+}
+
+void System::resetInternal(bool keep_trajectory) {
+  // Caller holds track_mutex_. The back end is parked before the map is cleared.
+  parkBackEnd();
   {
     std::lock_guard<std::mutex> ml(map_->update_mutex);
     Trajectory kfs;
@@ -184,8 +192,37 @@ void System::resetInternal(bool keep_trajectory) {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     ++stats_.resets;
   }
-  if (!localization_only_.load()) mapper_->resume();
-  if (loop_closer_) loop_closer_->start();
+  resumeBackEnd();
+}
+
+MapFileContext System::mapFileContext() const {
+  MapFileContext c;
+  c.camera = cam_;
+  c.orb_levels = orb_options_.n_levels;
+  c.orb_scale_factor = orb_options_.scale_factor;
+  c.vocabulary = voc_.get();
+  return c;
+}
+
+MapFileInfo System::saveMap(const std::string& path) const {
+  std::lock_guard<std::mutex> ml(map_->update_mutex);
+  return saveMapFile(path, *map_, mapFileContext());
+}
+
+MapFileInfo System::loadMap(const std::string& path) {
+  // Read and checked without any lock: the running map is not touched until this succeeded.
+  auto loaded = std::make_unique<Map>();
+  const MapFileInfo info = loadMapFile(path, mapFileContext(), *loaded);
+  std::lock_guard<std::mutex> tl(track_mutex_);
+  if (shut_down_) throw Error(path + ": cannot load a map into a System that was shut down");
+  parkBackEnd();
+  {
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    tracker_->startInLoadedMap();
+    map_->adopt(*loaded);
+  }
+  resumeBackEnd();
+  return info;
 }
 
 void System::reset() {

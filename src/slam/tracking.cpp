@@ -711,5 +711,12 @@ void Tracking::resetAll() {
   has_last_stamp_ = false;
 }
 
+void Tracking::startInLoadedMap() {
+  const size_t resets = resets_;
+  resetAll();
+  resets_ = resets;
+  state_ = TrackingState::Lost;
+}
+
 }  // namespace slam
 }  // namespace yolo_slam

@@ -1,7 +1,8 @@
 // yolo_slam_run on a short synthetic walking_xyz sequence (sim library, written to a temp
 // folder): screening metrics against the masks in stats.json, corrupt/missing masks, default
 // and explicit vocabulary/config handling, and Ctrl-C (SIGINT to the running child) still
-// writing the trajectory so far and a valid stats.json.
+// writing the trajectory so far, a valid stats.json and the map (--save-map); a saved map loaded
+// for localization (--load-map, --localization) and bad map files.
 #include "yolo_slam/common/json.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/sim/generator.h"
@@ -289,7 +290,9 @@ TEST_F(RunnerMetrics, BadVocabularyAndConfigAreOneLineErrors) {
 TEST_F(RunnerMetrics, CtrlCWritesTheFramesDoneSoFar) {
   const std::string out = joinPath(dir_, "out_sigint");
   // --realtime paces the 30 frames over about 1 s, so the signal lands mid-sequence.
-  Child c = spawn({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--no-vocabulary", "--realtime"},
+  const std::string map = joinPath(dir_, "sigint.ysmap");
+  Child c = spawn({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--no-vocabulary", "--realtime", "--save-map",
+                   map},
                   joinPath(dir_, "sigint"));
   ASSERT_GT(c.pid, 0);
   // The header line is printed once the signal handlers are installed.
@@ -310,6 +313,7 @@ TEST_F(RunnerMetrics, CtrlCWritesTheFramesDoneSoFar) {
   ASSERT_TRUE(js.is_object());
   EXPECT_EQ(js["interrupted"], true) << js.dump();
   EXPECT_EQ(numberOf(js, "trajectory_poses"), poses) << js.dump();
+  EXPECT_EQ(numberOf(js["map_file"]["saved"], "bytes"), static_cast<double>(fs::file_size(map))) << js.dump();
   const double frames = numberOf(js["screening_metrics"], "frames");
   EXPECT_GE(frames, 1) << js.dump();
   EXPECT_LT(frames, kFrames) << js.dump();
@@ -335,4 +339,50 @@ TEST_F(RunnerMetrics, CameraRateAndAsyncDetectionAccountForEveryFrame) {
   EXPECT_EQ(numberOf(det, "offered"), numberOf(cam, "processed")) << det.dump();
   EXPECT_EQ(numberOf(det, "offered"), numberOf(det, "detected") + numberOf(det, "replaced")) << det.dump();
   EXPECT_GE(numberOf(det, "frames_with_new_boxes"), 1) << det.dump();
+}
+
+TEST_F(RunnerMetrics, SavedMapIsLoadedForLocalization) {
+  const std::string map = joinPath(dir_, "walking.ysmap");
+  std::string so, se;
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", joinPath(dir_, "out_map_save"), "--boxes-from-gt", "--sequential",
+                     "--save-map", map},
+                    joinPath(dir_, "map_save"), so, se),
+            0)
+      << so << se;
+  const Json saved = statsOf(joinPath(dir_, "out_map_save"))["map_file"]["saved"];
+  ASSERT_TRUE(saved.is_object()) << saved.dump();
+  EXPECT_EQ(numberOf(saved, "bytes"), static_cast<double>(fs::file_size(map))) << saved.dump();
+  EXPECT_GT(numberOf(saved, "keyframes"), 0) << saved.dump();
+  EXPECT_GE(numberOf(saved, "ms"), 0) << saved.dump();
+
+  const std::string out = joinPath(dir_, "out_map_load");
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential", "--load-map", map,
+                     "--localization"},
+                    joinPath(dir_, "map_load"), so, se),
+            0)
+      << so << se;
+  const Json js = statsOf(out);
+  const Json mf = js["map_file"];
+  EXPECT_EQ(mf["localization"], true) << mf.dump();
+  EXPECT_TRUE(mf["saved"].is_null()) << mf.dump();
+  EXPECT_EQ(numberOf(mf["loaded"], "keyframes"), numberOf(saved, "keyframes")) << mf.dump();
+  // Localization: relocalised in the loaded map, which got no keyframe.
+  EXPECT_GE(numberOf(js, "relocalizations"), 1) << js.dump();
+  EXPECT_EQ(numberOf(js, "keyframes"), numberOf(saved, "keyframes")) << js.dump();
+  EXPECT_GT(numberOf(js, "trajectory_poses"), kFrames / 2) << js.dump();
+}
+
+TEST_F(RunnerMetrics, BadMapFilesAreOneLineErrors) {
+  std::string so, se;
+  const std::string missing = joinPath(dir_, "missing.ysmap");
+  EXPECT_EQ(runTool({"--sequence", seq(), "--out", joinPath(dir_, "o"), "--load-map", missing},
+                    joinPath(dir_, "map_missing"), so, se),
+            1);
+  EXPECT_EQ(se.rfind("error: " + missing + ": map file not found", 0), 0u) << se;
+  EXPECT_EQ(se.find('\n'), se.size() - 1) << se;
+  // A folder that does not exist fails before the run, not after it.
+  EXPECT_EQ(runTool({"--sequence", seq(), "--out", joinPath(dir_, "o"), "--save-map", "/nonexistent/m.ysmap"},
+                    joinPath(dir_, "map_nofolder"), so, se),
+            1);
+  EXPECT_EQ(se.rfind("error: /nonexistent/m.ysmap", 0), 0u) << se;
 }

@@ -52,6 +52,14 @@ class Map {
   // drawn without the mutex.
   long newKeyFrameId() { return next_kf_id_++; }
   long newPointId() { return next_point_id_++; }
+  // The ids the next keyframe / point will get (saved in map files so that ids stay unique).
+  long nextKeyFrameId() const { return next_kf_id_.load(); }
+  long nextPointId() const { return next_point_id_.load(); }
+  // Map files: ids continue after those of the loaded map. Caller holds update_mutex.
+  void restoreIdCounters(long next_kf_id, long next_point_id) {
+    next_kf_id_ = next_kf_id;
+    next_point_id_ = next_point_id;
+  }
 
   // Place-recognition index kept in step with the keyframe set: addKeyFrame adds a keyframe with
   // a filled BoW slot, eraseKeyFrame and clear remove. Set once before use (System); may be null.
@@ -83,6 +91,10 @@ class Map {
 
   // Drops everything, breaking the reference cycles first.
   void clear();
+  // Replaces this map's contents by `other`'s (a map loaded from a file): clears this map, takes
+  // other's keyframes, points, origin and id counters, and indexes the keyframes in this map's
+  // keyframe database. `other` is left empty. Caller holds update_mutex; `other` is not shared.
+  void adopt(Map& other);
 
  private:
   std::set<KeyFramePtr, ById> keyframes_;

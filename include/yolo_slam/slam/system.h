@@ -10,6 +10,7 @@
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/screening/screener.h"
+#include "yolo_slam/slam/map_file.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
 #include "yolo_slam/slam/types.h"
@@ -116,6 +117,15 @@ class System {
 
   void reset();
   void setLocalizationOnly(bool on);
+  // Map files (slam/map_file.h, docs/map-file.md). saveMap writes the current map with this
+  // System's camera, ORB pyramid and vocabulary identity; also after shutdown(). Throws
+  // yolo_slam::Error if the file cannot be written.
+  MapFileInfo saveMap(const std::string& path) const;
+  // Replaces the map by the one in `path` and forgets the trajectory: tracking starts lost and
+  // relocalises in the loaded map, so poses are in its world frame. The file is read into a new
+  // Map first; on any problem (yolo_slam::Error naming the file and the fix) the running map and
+  // tracking state are unchanged. Works before the first frame and with localization-only on.
+  MapFileInfo loadMap(const std::string& path);
   bool localizationOnly() const;
   // Finishes queued keyframes, a pending loop correction and a running global BA, then stops
   // and joins the mapping and loop-closing threads; idempotent. (Sequential: nothing is left
@@ -151,6 +161,12 @@ class System {
 
  private:
   void resetInternal(bool keep_trajectory);
+  // Around a map replacement (reset, load): loop closing stopped and cleared, local mapping
+  // parked and emptied; then both started again (local mapping unless localization-only).
+  // Caller holds track_mutex_.
+  void parkBackEnd();
+  void resumeBackEnd();
+  MapFileContext mapFileContext() const;
   // Sequential mode: local mapping, then loop closing, on what the last frame queued.
   void runBackEndInline();
 

@@ -45,6 +45,10 @@ class Tracking {
   void resetKeepTrajectory();
   // Full reset: trajectory too, next map starts at identity.
   void resetAll();
+  // The map is being replaced by one loaded from a file: forgets everything as resetAll (not
+  // counted as a reset) and starts lost, so the next frames relocalise in the loaded map instead
+  // of initialising a new one.
+  void startInLoadedMap();
 
   void setLocalizationOnly(bool on) { localization_only_ = on; }
   bool localizationOnly() const { return localization_only_; }
