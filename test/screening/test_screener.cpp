@@ -521,3 +521,63 @@ TEST(Screener, SilhouetteRuleDropsKeypointsOnThePersonsOutline) {
   EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.silhouetteRadius: -1\n", "s.yaml")), Error);
   EXPECT_EQ(ScreeningOptions::load(Config::fromString("Screening.silhouetteRadius: 5\n", "s.yaml")).silhouette_radius_px, 5.0);
 }
+
+TEST(OcclusionRule, FindsThePersonBehindAnotherOne) {
+  // Person A at 1.5 m, x in [300, 400); person B at 2.5 m behind and to the left, x in
+  // [200, 340): A covers B's right part. The wall at 4 m. B's box holds A's left part,
+  // which is B's box's nearest sizeable cluster, so without the rule B is never found.
+  features::FeatureFrame f;
+  f.width = 640;
+  f.height = 480;
+  std::vector<int> who;  // 0 wall, 1 A, 2 B
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  auto add = [&](float x, float y, float d, int id) {
+    f.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
+    f.depth.push_back(d);
+    who.push_back(id);
+  };
+  for (int i = 0; i < 120; ++i) add(300 + 100 * u(rng), 60 + 400 * u(rng), 1.4f + 0.2f * u(rng), 1);
+  for (int i = 0; i < 50; ++i) add(200 + 100 * u(rng), 80 + 380 * u(rng), 2.4f + 0.2f * u(rng), 2);
+  for (int i = 0; i < 120; ++i) {
+    const float x = u(rng) < 0.5f ? 100 + 95 * u(rng) : 405 + 200 * u(rng);
+    add(x, 480 * u(rng), 3.9f + 0.2f * u(rng), 0);
+  }
+  f.keypoints_un = f.keypoints;
+  detection::Boxes boxes(2);
+  boxes[0].rect = cv::Rect2f(295, 50, 110, 420);  // A
+  boxes[1].rect = cv::Rect2f(195, 70, 200, 400);  // B, overlapping A's left part
+  for (auto& b : boxes) b.score = 0.9f;
+  auto droppedOf = [&](bool rule) {
+    ScreeningOptions o;
+    o.occlusion_rule = rule;
+    o.box_dilation = 0;
+    features::FeatureFrame g = f;
+    const ScreeningStats st = Screener(o).screen(g, boxes);
+    int dropped[3] = {0, 0, 0};
+    for (size_t i = 0; i < g.size(); ++i) dropped[who[i]] += g.dynamic[i];
+    EXPECT_EQ(st.occluded_boxes, rule ? 1 : 0);
+    return std::vector<int>(dropped, dropped + 3);
+  };
+  const std::vector<int> off = droppedOf(false), on = droppedOf(true);
+  EXPECT_EQ(off[1], 120);
+  EXPECT_LT(off[2], 10);  // B kept: its box found A
+  EXPECT_EQ(on[1], 120);
+  EXPECT_GE(on[2], 45);   // B found behind A
+  EXPECT_LE(on[0], off[0] + 2);  // and not the wall
+}
+
+TEST(OcclusionRule, LeavesADuplicateDetectionAlone) {
+  // Two boxes around one person (two models, or a carried box next to a detection) overlap by
+  // far more than occlusionMaxIou: the second is not screened again, the wall stays.
+  Scene s = makeScene(3);
+  detection::Box dup = s.boxes[0];
+  dup.rect = cv::Rect2f(105, 55, 190, 410);
+  s.boxes.push_back(dup);
+  ScreeningOptions o;
+  const ScreeningStats st = Screener(o).screen(s.frame, s.boxes);
+  EXPECT_EQ(st.occluded_boxes, 0);
+  int wall_dropped = 0;
+  for (size_t i = 0; i < s.frame.size(); ++i) wall_dropped += !s.person[i] && s.frame.dynamic[i];
+  EXPECT_LE(wall_dropped, 6);
+}
