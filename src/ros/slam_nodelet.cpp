@@ -1,7 +1,7 @@
 // yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Outputs follow REP 103 /
 // REP 105: tf map -> odom -> base_link (or map -> camera when asked), the base pose, its path,
 // the static map points, keyframes with covisibility edges and a debug image; services reset,
-// save_trajectory (TUM format) and set_localization_mode.
+// save_trajectory (TUM format), set_localization_mode, save_map and load_map (map files).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -29,6 +29,7 @@
 
 #include "nodelet_common.h"
 #include "yolo_slam/KeypointFrame.h"
+#include "yolo_slam/MapFile.h"
 #include "yolo_slam/SaveTrajectory.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
@@ -98,6 +99,9 @@ class SlamNodelet : public nodelet::Nodelet {
     pnh.param("publish_odom_tf", publish_odom_tf_, true);
     pnh.param("publish_map_to_camera", map_to_camera_, false);
     pnh.param<std::string>("trajectory_path", trajectory_path_, "");
+    pnh.param<std::string>("map_file", map_file_, "");
+    pnh.param("localization_mode", localization_only_, false);
+    pending_map_ = map_file_;
     pnh.param("map_publish_period", map_period_, 1.0);
     pnh.param("debug_image", debug_image_, true);
     std::vector<double> b2c{0, 0, 0, -0.5, 0.5, -0.5, 0.5};
@@ -138,6 +142,8 @@ class SlamNodelet : public nodelet::Nodelet {
     save_srv_ = nh.advertiseService("yolo_slam/save_trajectory", &SlamNodelet::onSave, this);
     loc_srv_ = nh.advertiseService("yolo_slam/set_localization_mode", &SlamNodelet::onLocalization,
                                    this);
+    save_map_srv_ = nh.advertiseService("yolo_slam/save_map", &SlamNodelet::onSaveMap, this);
+    load_map_srv_ = nh.advertiseService("yolo_slam/load_map", &SlamNodelet::onLoadMap, this);
     if (!publish_odom_tf_ && publish_tf_ && !map_to_camera_) {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
@@ -192,11 +198,7 @@ class SlamNodelet : public nodelet::Nodelet {
                     std::to_string(cam.width) + "x" + std::to_string(cam.height));
       Stopwatch sw;
       std::lock_guard<std::mutex> lock(system_mutex_);
-      if (!system_) {
-        system_ = std::make_unique<slam::System>(cam, settings_, vocabulary_);
-        NODELET_INFO("Slam: started (fx %.1f fy %.1f cx %.1f cy %.1f, %dx%d)", cam.fx, cam.fy,
-                     cam.cx, cam.cy, cam.width, cam.height);
-      }
+      if (!system_) startSystem(cam);
       res = system_->trackFeatures(frame);
       track_ms_.push_back(sw.ms());
       if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
@@ -513,6 +515,87 @@ class SlamNodelet : public nodelet::Nodelet {
     return true;
   }
 
+  // The System needs the camera, so it starts with the first frame; the localization mode and
+  // a map asked for before then (~localization_mode, ~map_file, the services) apply here.
+  // Caller holds system_mutex_.
+  void startSystem(const CameraModel& cam) {
+    system_ = std::make_unique<slam::System>(cam, settings_, vocabulary_);
+    NODELET_INFO("Slam: started (fx %.1f fy %.1f cx %.1f cy %.1f, %dx%d)", cam.fx, cam.fy, cam.cx,
+                 cam.cy, cam.width, cam.height);
+    if (localization_only_) system_->setLocalizationOnly(true);
+    if (pending_map_.empty()) return;
+    try {
+      const slam::MapFileInfo info = system_->loadMap(pending_map_);
+      NODELET_INFO("Slam: map %s loaded (%zu keyframes, %zu points, %.0f ms); relocalising in it",
+                   pending_map_.c_str(), info.keyframes, info.map_points, info.ms);
+    } catch (const std::exception& e) {
+      NODELET_ERROR("Slam: %s; starting with an empty map", e.what());
+    }
+    pending_map_.clear();
+  }
+
+  // The request's path, else ~map_file; empty when neither is set (the response says so).
+  std::string mapPath(const std::string& requested, yolo_slam::MapFile::Response& res) const {
+    const std::string path = requested.empty() ? map_file_ : requested;
+    if (path.empty()) {
+      res.success = false;
+      res.message = "no path in the request and no ~map_file parameter";
+    }
+    return path;
+  }
+
+  void fill(const slam::MapFileInfo& info, const std::string& path, yolo_slam::MapFile::Response& res) {
+    res.success = true;
+    res.message = path;
+    res.keyframes = static_cast<uint32_t>(info.keyframes);
+    res.map_points = static_cast<uint32_t>(info.map_points);
+  }
+
+  bool onSaveMap(yolo_slam::MapFile::Request& req, yolo_slam::MapFile::Response& res) {
+    const std::string path = mapPath(req.path, res);
+    if (path.empty()) return true;
+    try {
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      if (!system_) throw Error("no map yet: the first frame has not arrived");
+      const slam::MapFileInfo info = system_->saveMap(path);
+      fill(info, path, res);
+      NODELET_INFO("Slam: map saved to %s (%zu keyframes, %zu points, %.0f ms)", path.c_str(), info.keyframes,
+                   info.map_points, info.ms);
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      NODELET_ERROR("Slam: save_map failed: %s", e.what());
+    }
+    return true;
+  }
+
+  bool onLoadMap(yolo_slam::MapFile::Request& req, yolo_slam::MapFile::Response& res) {
+    const std::string path = mapPath(req.path, res);
+    if (path.empty()) return true;
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    if (!system_) {
+      pending_map_ = path;
+      res.success = true;
+      res.message = path + ": loaded when the first frame arrives (the camera is not known yet)";
+      return true;
+    }
+    try {
+      const slam::MapFileInfo info = system_->loadMap(path);
+      fill(info, path, res);
+      {
+        std::lock_guard<std::mutex> plock(path_mutex_);
+        path_.poses.clear();
+      }
+      NODELET_INFO("Slam: map %s loaded (%zu keyframes, %zu points); relocalising in it", path.c_str(),
+                   info.keyframes, info.map_points);
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = e.what();
+      NODELET_ERROR("Slam: load_map failed, the running map is kept: %s", e.what());
+    }
+    return true;
+  }
+
   bool onLocalization(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
     std::lock_guard<std::mutex> lock(system_mutex_);
     localization_only_ = req.data;
@@ -528,7 +611,7 @@ class SlamNodelet : public nodelet::Nodelet {
   ErrorThrottle throttle_;
   bool map_to_camera_ = false, debug_image_ = true;
   double map_period_ = 1.0;
-  std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_;
+  std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_, map_file_;
   Pose T_bc_ = Pose::Identity();  // camera pose in base_link
   Config settings_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
@@ -540,6 +623,7 @@ class SlamNodelet : public nodelet::Nodelet {
   std::mutex system_mutex_;
   std::unique_ptr<slam::System> system_;
   bool localization_only_ = false;
+  std::string pending_map_;  // loaded when the System starts (set before the first frame)
   std::vector<double> track_ms_;
 
   std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
@@ -559,7 +643,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
   ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;
   ::ros::Publisher pose_pub_, path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
-  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_;
+  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_;
   ::ros::WallTimer map_timer_, diag_timer_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;

@@ -26,6 +26,7 @@
 
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
+#include "yolo_slam/MapFile.h"
 #include "yolo_slam/SaveTrajectory.h"
 #include "yolo_slam/eval/ate.h"
 #include "yolo_slam/io/trajectory.h"
@@ -233,6 +234,26 @@ TEST(FullGraph, SyntheticWalkingBag) {
               ate.stats.rmse, ate.stats.count, ate_bound, srv.request.path.c_str());
   EXPECT_LT(ate.stats.rmse, ate_bound);
   EXPECT_GE(static_cast<long>(ate.stats.count), tracked - 2);
+
+  // The map through the services: saved, loaded again, and a bad file refused with the
+  // running map kept.
+  yolo_slam::MapFile save;
+  save.request.path = dir + "/map.ysmap";
+  ASSERT_TRUE(ros::service::call("/yolo_slam/save_map", save));
+  ASSERT_TRUE(save.response.success) << save.response.message;
+  EXPECT_GT(save.response.keyframes, 0u);
+  EXPECT_GT(save.response.map_points, 0u);
+  yolo_slam::MapFile bad;
+  bad.request.path = dir + "/trajectory.txt";
+  ASSERT_TRUE(ros::service::call("/yolo_slam/load_map", bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("trajectory.txt"), std::string::npos) << bad.response.message;
+  yolo_slam::MapFile load;
+  load.request.path = save.request.path;
+  ASSERT_TRUE(ros::service::call("/yolo_slam/load_map", load));
+  ASSERT_TRUE(load.response.success) << load.response.message;
+  EXPECT_EQ(load.response.keyframes, save.response.keyframes);
+  EXPECT_EQ(load.response.map_points, save.response.map_points);
 
   if (rviz) {
     std::ofstream(dir + "/shoot").put('\n');
