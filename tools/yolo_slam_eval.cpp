@@ -23,7 +23,7 @@ namespace {
 
 const char* kUsage =
     "usage:\n"
-    "  yolo_slam_eval ate GT EST [--max-diff 0.02] [--plot out.png] [--json]\n"
+    "  yolo_slam_eval ate GT EST [--max-diff 0.02] [--plot out.png] [--json] [--align-with GT0 EST0]\n"
     "  yolo_slam_eval rpe GT EST [--delta 1] [--delta-unit s|f] [--max-diff SECONDS] [--json]\n"
     "\n"
     "GT and EST are TUM trajectories ('timestamp tx ty tz qx qy qz qw' per line, camera to\n"
@@ -33,7 +33,8 @@ const char* kUsage =
     "     (pairs closer than --max-diff seconds, default 0.02, greedy by smallest difference),\n"
     "     estimate aligned onto the ground truth by a rigid transform (Horn, no scale);\n"
     "     translational error statistics in metres. --plot writes a PNG with the top view and\n"
-    "     the error over time.\n"
+    "     the error over time. --align-with GT0 EST0: no alignment of its own; the one of EST0\n"
+    "     onto GT0 is used (a run in a loaded map, evaluated in the mapping run's frame).\n"
     "rpe  relative pose error as TUM evaluate_rpe.py --fixed_delta: pose pairs --delta apart\n"
     "     (unit s = seconds, the default, or f = frames of the estimate); translational error in\n"
     "     metres per delta, rotational error in degrees per delta. Each estimate stamp is matched\n"
@@ -79,16 +80,25 @@ Json errorStatsJson(const eval::ErrorStats& s, const std::string& prefix, const 
   return j;
 }
 
-int runAte(const std::string& gt_path, const std::string& est_path, double max_diff,
-           const std::string& plot, bool json) {
+// computeAte with the stamp association's error context (the files).
+eval::AteResult ateOf(const std::string& gt_path, const std::string& est_path, double max_diff,
+                      const Pose* fixed_alignment = nullptr) {
   const Trajectory gt = load(gt_path, "ground-truth");
   const Trajectory est = load(est_path, "estimated");
-  eval::AteResult r;
   try {
-    r = eval::computeAte(gt, est, max_diff);
+    return eval::computeAte(gt, est, max_diff, 0.0, fixed_alignment);
   } catch (const Error& e) {
     throw Error(est_path + " vs " + gt_path + ": " + e.what());
   }
+}
+
+int runAte(const std::string& gt_path, const std::string& est_path, double max_diff,
+           const std::string& plot, bool json, const std::vector<std::string>& align_with) {
+  const Trajectory gt = load(gt_path, "ground-truth");
+  const Trajectory est = load(est_path, "estimated");
+  Pose fixed = Pose::Identity();
+  if (!align_with.empty()) fixed = ateOf(align_with[0], align_with[1], max_diff).alignment;
+  const eval::AteResult r = ateOf(gt_path, est_path, max_diff, align_with.empty() ? nullptr : &fixed);
   // Everything that can fail happens before anything is printed.
   if (!plot.empty()) {
     char title[256];
@@ -187,6 +197,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> pos;
   double max_diff = -1;
   std::string plot;
+  std::vector<std::string> align_with;  // GT0 EST0 whose alignment is used
   bool json = false;
   eval::RpeOptions ropt;
   for (size_t i = 1; i < args.size(); ++i) {
@@ -200,6 +211,8 @@ int run(int argc, char** argv) {
     } else if (a == "--max-diff") {
       max_diff = parseNumber(a, value());
       if (!(max_diff > 0)) throw UsageError("--max-diff must be > 0 seconds");
+    } else if (a == "--align-with" && cmd == "ate") {
+      align_with = {value(), value()};
     } else if (a == "--plot" && cmd == "ate") {
       plot = value();
       if (plot.empty()) throw UsageError("--plot needs a file name");
@@ -219,7 +232,7 @@ int run(int argc, char** argv) {
     }
   }
   if (pos.size() != 2) throw UsageError(cmd + " needs exactly two files: GT EST");
-  if (cmd == "ate") return runAte(pos[0], pos[1], max_diff > 0 ? max_diff : 0.02, plot, json);
+  if (cmd == "ate") return runAte(pos[0], pos[1], max_diff > 0 ? max_diff : 0.02, plot, json, align_with);
   ropt.max_time_diff = max_diff > 0 ? max_diff : 0.0;
   return runRpe(pos[0], pos[1], ropt, json);
 }

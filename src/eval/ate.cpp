@@ -51,7 +51,7 @@ Trajectory uniqueByStamp(const Trajectory& traj) {
 }
 
 AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double max_diff,
-                     double offset) {
+                     double offset, const Pose* fixed_alignment) {
   if (gt_in.empty()) throw Error("ATE: the ground-truth trajectory has no poses");
   if (est_in.empty()) throw Error("ATE: the estimated trajectory has no poses");
   const Trajectory gt = uniqueByStamp(gt_in);
@@ -74,7 +74,7 @@ AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double m
     r.gt_positions.push_back(gt[m.first].T_wc.translation());
     est_pos.push_back(est[m.second].T_wc.translation());
   }
-  r.alignment = alignRigid(est_pos, r.gt_positions);
+  r.alignment = fixed_alignment ? *fixed_alignment : alignRigid(est_pos, r.gt_positions);
   for (size_t k = 0; k < est_pos.size(); ++k) {
     r.est_aligned.push_back(r.alignment * est_pos[k]);
     r.errors.push_back((r.est_aligned[k] - r.gt_positions[k]).norm());

@@ -191,3 +191,26 @@ TEST(Ate, RealReferenceTrajectories) {
   EXPECT_THROW(eval::writeAtePlot("/tmp/ys_no_such_dir/x.png", gt, est, r, "t"), Error);
   EXPECT_FALSE(std::ifstream("/tmp/ys_eval_plot.jpg").good());
 }
+
+TEST(Ate, FixedAlignmentIsUsedAsGiven) {
+  // A second run in the first run's map frame W: the first run's alignment (W^-1) makes it
+  // exact; a wrong map frame shows as an error a fresh alignment would hide.
+  std::mt19937 rng(12);
+  Trajectory gt;
+  for (int k = 0; k < 30; ++k) {
+    StampedPose p;
+    p.stamp = 20 + 0.033 * k;
+    p.T_wc = randomPose(rng);
+    gt.push_back(p);
+  }
+  const Pose W = randomPose(rng);
+  Trajectory est = gt;
+  for (auto& p : est) p.T_wc = W * p.T_wc;
+  const Pose first_run_alignment = eval::computeAte(gt, est).alignment;
+  EXPECT_LT(eval::computeAte(gt, est, 0.02, 0.0, &first_run_alignment).stats.rmse, 1e-9);
+  Pose shifted = first_run_alignment;
+  shifted.translation() += Eigen::Vector3d(0.1, 0, 0);
+  const eval::AteResult off = eval::computeAte(gt, est, 0.02, 0.0, &shifted);
+  EXPECT_NEAR(off.stats.rmse, 0.1, 1e-9);
+  EXPECT_TRUE(off.alignment.isApprox(shifted, 1e-12));
+}

@@ -34,8 +34,10 @@ struct AteResult {
 // gt and est are deduplicated with uniqueByStamp, associated with io::associate(gt, est,
 // offset, max_diff) as evaluate_ate.py does, and aligned. Throws yolo_slam::Error if either is
 // empty or fewer than 2 pairs are found ("no overlapping timestamps").
+// fixed_alignment: use this T_gt_est instead of aligning (a run in a loaded map, evaluated in
+// the frame the mapping run's alignment gives that map).
 AteResult computeAte(const Trajectory& gt, const Trajectory& est, double max_diff = 0.02,
-                     double offset = 0.0);
+                     double offset = 0.0, const Pose* fixed_alignment = nullptr);
 
 }  // namespace eval
 }  // namespace yolo_slam
