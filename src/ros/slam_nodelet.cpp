@@ -551,6 +551,12 @@ class SlamNodelet : public nodelet::Nodelet {
     res.map_points = static_cast<uint32_t>(info.map_points);
   }
 
+  void fail(yolo_slam::MapFile::Response& res, const char* what, const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    NODELET_ERROR("Slam: %s: %s", what, e.what());
+  }
+
   bool onSaveMap(yolo_slam::MapFile::Request& req, yolo_slam::MapFile::Response& res) {
     const std::string path = mapPath(req.path, res);
     if (path.empty()) return true;
@@ -562,9 +568,7 @@ class SlamNodelet : public nodelet::Nodelet {
       NODELET_INFO("Slam: map saved to %s (%zu keyframes, %zu points, %.0f ms)", path.c_str(), info.keyframes,
                    info.map_points, info.ms);
     } catch (const std::exception& e) {
-      res.success = false;
-      res.message = e.what();
-      NODELET_ERROR("Slam: save_map failed: %s", e.what());
+      fail(res, "save_map failed", e);
     }
     return true;
   }
@@ -589,9 +593,7 @@ class SlamNodelet : public nodelet::Nodelet {
       NODELET_INFO("Slam: map %s loaded (%zu keyframes, %zu points); relocalising in it", path.c_str(),
                    info.keyframes, info.map_points);
     } catch (const std::exception& e) {
-      res.success = false;
-      res.message = e.what();
-      NODELET_ERROR("Slam: load_map failed, the running map is kept: %s", e.what());
+      fail(res, "load_map failed, the running map is kept", e);
     }
     return true;
   }

@@ -21,6 +21,18 @@ Pose randomPose(std::mt19937& rng) {
   return makePose(q.normalized(), Eigen::Vector3d(u(rng), u(rng), u(rng)) * 3);
 }
 
+// n random poses from stamp t0 at 30 Hz.
+Trajectory randomTrajectory(std::mt19937& rng, int n, double t0) {
+  Trajectory t;
+  for (int k = 0; k < n; ++k) {
+    StampedPose p;
+    p.stamp = t0 + 0.033 * k;
+    p.T_wc = randomPose(rng);
+    t.push_back(p);
+  }
+  return t;
+}
+
 Trajectory fromPositions(const std::vector<Eigen::Vector3d>& p, double t0 = 100.0, double dt = 0.1) {
   Trajectory t;
   for (size_t k = 0; k < p.size(); ++k) {
@@ -86,13 +98,7 @@ TEST(AlignRigid, PlanarPointsGiveRotationNotReflection) {
 
 TEST(Ate, ZeroForIdenticalAndRigidlyMovedTrajectories) {
   std::mt19937 rng(11);
-  Trajectory gt;
-  for (int k = 0; k < 40; ++k) {
-    StampedPose p;
-    p.stamp = 10 + 0.033 * k;
-    p.T_wc = randomPose(rng);
-    gt.push_back(p);
-  }
+  const Trajectory gt = randomTrajectory(rng, 40, 10);
   eval::AteResult r = eval::computeAte(gt, gt);
   EXPECT_EQ(r.stats.count, 40u);
   EXPECT_LT(r.stats.rmse, 1e-12);
@@ -196,13 +202,7 @@ TEST(Ate, FixedAlignmentIsUsedAsGiven) {
   // A second run in the first run's map frame W: the first run's alignment (W^-1) makes it
   // exact; a wrong map frame shows as an error a fresh alignment would hide.
   std::mt19937 rng(12);
-  Trajectory gt;
-  for (int k = 0; k < 30; ++k) {
-    StampedPose p;
-    p.stamp = 20 + 0.033 * k;
-    p.T_wc = randomPose(rng);
-    gt.push_back(p);
-  }
+  const Trajectory gt = randomTrajectory(rng, 30, 20);
   const Pose W = randomPose(rng);
   Trajectory est = gt;
   for (auto& p : est) p.T_wc = W * p.T_wc;
