@@ -39,6 +39,8 @@ DEPENDENCIES='
   rostest:            python3-rostest
   rosgraph_msgs:      libros-rosgraph-msgs-dev
   gtest:              libgtest-dev
+  xvfb:               xvfb
+  imagemagick:        imagemagick
   data:               opencv-doc darknet
 '
 # data: real images and video (textures and people for the simulator, vocabulary training

@@ -1,7 +1,7 @@
-// yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Outputs follow REP 103 /
-// REP 105: tf map -> odom -> base_link (or map -> camera when asked), the base pose, its path,
-// the static map points, keyframes with covisibility edges and a debug image; services reset,
-// save_trajectory (TUM format), set_localization_mode, save_map and load_map (map files).
+// yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Pose, odometry and tf follow
+// REP 103 / REP 105 (pose_output.h); also the path, the static map points, keyframes with
+// covisibility edges and a debug image; services reset, save_trajectory (TUM format),
+// set_localization_mode, save_map and load_map (map files).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -16,9 +16,6 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_broadcaster.h>
-#include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <opencv2/imgproc.hpp>
 
@@ -28,6 +25,7 @@
 #include <mutex>
 
 #include "nodelet_common.h"
+#include "pose_output.h"
 #include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/MapFile.h"
 #include "yolo_slam/SaveTrajectory.h"
@@ -51,16 +49,6 @@ const char* stateName(slam::TrackingState s) {
     case slam::TrackingState::Lost: return "lost";
   }
   return "?";
-}
-
-// [x y z qx qy qz qw] -> Pose; throws Error naming the parameter.
-Pose poseFromParam(const std::vector<double>& v, const std::string& name) {
-  if (v.size() != 7)
-    throw Error("parameter " + name + " needs 7 numbers [x, y, z, qx, qy, qz, qw], got " +
-                std::to_string(v.size()));
-  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-  if (q.norm() < 1e-9) throw Error("parameter " + name + " has a zero quaternion");
-  return makePose(q, Eigen::Vector3d(v[0], v[1], v[2]));
 }
 
 }  // namespace
@@ -91,25 +79,16 @@ class SlamNodelet : public nodelet::Nodelet {
     int queue_size = 100;
     pnh.param("queue_size", queue_size, 100);
     pnh.param("use_camera_info", use_camera_info_, true);
-    pnh.param<std::string>("map_frame", map_frame_, "map");
-    pnh.param<std::string>("odom_frame", odom_frame_, "odom");
-    pnh.param<std::string>("base_frame", base_frame_, "base_link");
-    pnh.param<std::string>("camera_frame", camera_frame_, "");
-    pnh.param("publish_tf", publish_tf_, true);
-    pnh.param("publish_odom_tf", publish_odom_tf_, true);
-    pnh.param("publish_map_to_camera", map_to_camera_, false);
     pnh.param<std::string>("trajectory_path", trajectory_path_, "");
     pnh.param<std::string>("map_file", map_file_, "");
     pnh.param("localization_mode", localization_only_, false);
     pending_map_ = map_file_;
     pnh.param("map_publish_period", map_period_, 1.0);
     pnh.param("debug_image", debug_image_, true);
-    std::vector<double> b2c{0, 0, 0, -0.5, 0.5, -0.5, 0.5};
-    pnh.param("base_to_camera", b2c, b2c);
     std::string settings_path, voc_path;
     pnh.param<std::string>("vocabulary", voc_path, "");
     try {
-      T_bc_ = poseFromParam(b2c, pnh.resolveName("base_to_camera"));
+      pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
       settings_ = loadSettings(pnh, &settings_path);
       camera_.configure(baseCamera(settings_), use_camera_info_);
       if (!voc_path.empty()) {
@@ -126,7 +105,6 @@ class SlamNodelet : public nodelet::Nodelet {
       return;
     }
 
-    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("yolo_slam/pose", 10);
     path_pub_ = nh.advertise<nav_msgs::Path>("yolo_slam/path", 1, true);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("yolo_slam/map_points", 1, true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
@@ -144,21 +122,12 @@ class SlamNodelet : public nodelet::Nodelet {
                                    this);
     save_map_srv_ = nh.advertiseService("yolo_slam/save_map", &SlamNodelet::onSaveMap, this);
     load_map_srv_ = nh.advertiseService("yolo_slam/load_map", &SlamNodelet::onLoadMap, this);
-    if (!publish_odom_tf_ && publish_tf_ && !map_to_camera_) {
-      tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
-      tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
-    }
     if (map_period_ > 0)
       map_timer_ = nh.createWallTimer(::ros::WallDuration(map_period_),
                                       [this](const ::ros::WallTimerEvent&) { publishMap(); });
     diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
                                      [this](const ::ros::WallTimerEvent&) { publishDiagnostics(); });
-    NODELET_INFO("Slam: tf %s, settings '%s'",
-                 !publish_tf_ ? "off"
-                 : map_to_camera_ ? (map_frame_ + " -> camera").c_str()
-                 : publish_odom_tf_ ? (map_frame_ + " -> " + odom_frame_ + " -> " + base_frame_).c_str()
-                                    : (map_frame_ + " -> " + odom_frame_ + " (odometry from tf)").c_str(),
-                 settings_path.c_str());
+    NODELET_INFO("Slam: tf %s, settings '%s'", pose_out_->describe().c_str(), settings_path.c_str());
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -188,7 +157,12 @@ class SlamNodelet : public nodelet::Nodelet {
     last_index_ = msg->index;
     ++received_;
     slam::TrackResult res;
+    size_t corrections = 0;
     features::FeatureFrame frame;
+    if (!pose_out_->ready(msg->header.frame_id)) {
+      ++rejected_;
+      return;
+    }
     try {
       const CameraModel cam = camera();
       frame = fromMsg(*msg, cam);
@@ -200,6 +174,7 @@ class SlamNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(system_mutex_);
       if (!system_) startSystem(cam);
       res = system_->trackFeatures(frame);
+      corrections = system_->mapCorrections();
       track_ms_.push_back(sw.ms());
       if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
@@ -211,7 +186,7 @@ class SlamNodelet : public nodelet::Nodelet {
     last_state_ = res.state;
     if (res.state == slam::TrackingState::Ok) {
       ++tracked_;
-      publishPose(*msg, res.T_wc);
+      publishPose(*msg, res, corrections);
       recordLatency(msg->header.stamp);
     } else {
       ++not_tracked_;
@@ -229,63 +204,12 @@ class SlamNodelet : public nodelet::Nodelet {
     if (latency_ms_.size() > kLatencyWindow) latency_ms_.erase(latency_ms_.begin(), latency_ms_.begin() + kLatencyWindow / 2);
   }
 
-  // Camera pose in the SLAM world (first camera frame) -> base_link pose in the map frame
-  // (the first base_link frame, so the map is z-up when base_to_camera is right).
-  Pose mapFromWorld(const Pose& T_wc) const { return T_bc_ * T_wc * T_bc_.inverse(); }
-
-  void publishPose(const KeypointFrame& msg, const Pose& T_wc) {
-    const ::ros::Time stamp = msg.header.stamp;
-    std::string camera_frame = camera_frame_.empty() ? msg.header.frame_id : camera_frame_;
-    // TUM bags name frames "/openni_rgb_optical_frame"; tf2 frame ids may not start with '/'.
-    while (!camera_frame.empty() && camera_frame.front() == '/') camera_frame.erase(0, 1);
-    if (camera_frame.empty()) camera_frame = "camera_rgb_optical_frame";
-    // Pose of the published child frame in the map frame.
-    const Pose T_map_base = mapFromWorld(T_wc);
-    const Pose T_map_cam = T_bc_ * T_wc;
-    geometry_msgs::PoseStamped ps;
-    ps.header.stamp = stamp;
-    ps.header.frame_id = map_frame_;
-    ps.pose = poseToMsg(map_to_camera_ ? T_map_cam : T_map_base);
-    pose_pub_.publish(ps);
-    {
-      std::lock_guard<std::mutex> lock(path_mutex_);
-      path_.header = ps.header;
-      path_.poses.push_back(ps);
-      path_pub_.publish(path_);
-    }
-    if (!publish_tf_) return;
-    std::vector<geometry_msgs::TransformStamped> tfs;
-    auto add = [&](const std::string& parent, const std::string& child, const Pose& T) {
-      geometry_msgs::TransformStamped t;
-      t.header.stamp = stamp;
-      t.header.frame_id = parent;
-      t.child_frame_id = child;
-      t.transform = transformToMsg(T);
-      tfs.push_back(t);
-    };
-    if (map_to_camera_) {
-      add(map_frame_, camera_frame, T_map_cam);
-    } else if (publish_odom_tf_) {
-      // Visual odometry is the only motion source: odom follows the SLAM pose, map -> odom
-      // stays identity (loop closures show up as jumps of odom -> base_link).
-      add(map_frame_, odom_frame_, Pose::Identity());
-      add(odom_frame_, base_frame_, T_map_base);
-      add(base_frame_, camera_frame, T_bc_);
-    } else {
-      // Wheel/IMU odometry publishes odom -> base_link; we correct its drift with map -> odom.
-      try {
-        const auto t = tf_buffer_->lookupTransform(odom_frame_, base_frame_, stamp,
-                                                   ::ros::Duration(0.1));
-        const Pose T_odom_base = transformFromMsg(t.transform);
-        add(map_frame_, odom_frame_, T_map_base * T_odom_base.inverse());
-      } catch (const std::exception& e) {
-        NODELET_ERROR_THROTTLE(2.0, "Slam: no %s -> %s transform at %.3f (%s); map -> odom not "
-                               "published. Set ~publish_odom_tf true if nothing else publishes "
-                               "odometry", odom_frame_.c_str(), base_frame_.c_str(),
-                               stamp.toSec(), e.what());
-      }
-    }
-    if (!tfs.empty()) tf_broadcaster_.sendTransform(tfs);
+  void publishPose(const KeypointFrame& msg, const slam::TrackResult& res, size_t corrections) {
+    const geometry_msgs::PoseStamped ps = pose_out_->publish(msg.header.stamp, res.T_wc, res.inliers, corrections);
+    std::lock_guard<std::mutex> lock(path_mutex_);
+    path_.header = ps.header;
+    path_.poses.push_back(ps);
+    path_pub_.publish(path_);
   }
 
   void publishDebug(const KeypointFrame& msg, const slam::TrackResult& res) {
@@ -345,29 +269,30 @@ class SlamNodelet : public nodelet::Nodelet {
     // Path rebuilt from the optimised trajectory (local BA and loop closing move old poses).
     if (!traj.empty()) {
       std::lock_guard<std::mutex> lock(path_mutex_);
-      path_.header.frame_id = map_frame_;
+      path_.header.frame_id = pose_out_->mapFrame();
       path_.header.stamp = ::ros::Time(traj.back().stamp);
       path_.poses.clear();
       path_.poses.reserve(traj.size());
       for (const auto& sp : traj) {
         geometry_msgs::PoseStamped ps;
-        ps.header.frame_id = map_frame_;
+        ps.header.frame_id = pose_out_->mapFrame();
         ps.header.stamp = ::ros::Time(sp.stamp);
-        ps.pose = poseToMsg(map_to_camera_ ? T_bc_ * sp.T_wc : mapFromWorld(sp.T_wc));
+        ps.pose = poseToMsg(pose_out_->publishedPose(sp.T_wc));
         path_.poses.push_back(ps);
       }
       path_pub_.publish(path_);
     }
 
     auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
-    cloud->header.frame_id = map_frame_;
+    const Pose T_map_world = pose_out_->worldInMap();
+    cloud->header.frame_id = pose_out_->mapFrame();
     cloud->header.stamp = now;
     sensor_msgs::PointCloud2Modifier mod(*cloud);
     mod.setPointCloud2FieldsByString(1, "xyz");
     mod.resize(snap.points.size());
     sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
     for (const auto& p : snap.points) {
-      const Eigen::Vector3d q = T_bc_ * p;
+      const Eigen::Vector3d q = T_map_world * p;
       *x = static_cast<float>(q.x());
       *y = static_cast<float>(q.y());
       *z = static_cast<float>(q.z());
@@ -377,7 +302,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
     visualization_msgs::Marker kf, edges;
-    kf.header.frame_id = edges.header.frame_id = map_frame_;
+    kf.header.frame_id = edges.header.frame_id = pose_out_->mapFrame();
     kf.header.stamp = edges.header.stamp = now;
     kf.ns = "keyframes";
     edges.ns = "covisibility";
@@ -402,7 +327,7 @@ class SlamNodelet : public nodelet::Nodelet {
     const Eigen::Vector3d corners[4] = {{-w, -h, d}, {w, -h, d}, {w, h, d}, {-w, h, d}};
     std::vector<Eigen::Vector3d> centres;
     for (const auto& k : snap.keyframes) {
-      const Pose T = T_bc_ * k.T_wc;
+      const Pose T = T_map_world * k.T_wc;
       const Eigen::Vector3d o = T.translation();
       centres.push_back(o);
       for (int i = 0; i < 4; ++i) {
@@ -609,12 +534,11 @@ class SlamNodelet : public nodelet::Nodelet {
   }
 
   // Parameters (const after onInit).
-  bool use_camera_info_ = true, publish_tf_ = true, publish_odom_tf_ = true;
+  bool use_camera_info_ = true;
   ErrorThrottle throttle_;
-  bool map_to_camera_ = false, debug_image_ = true;
+  bool debug_image_ = true;
   double map_period_ = 1.0;
-  std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_, map_file_;
-  Pose T_bc_ = Pose::Identity();  // camera pose in base_link
+  std::string trajectory_path_, map_file_;
   Config settings_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
@@ -644,12 +568,13 @@ class SlamNodelet : public nodelet::Nodelet {
   std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
 
   ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;
-  ::ros::Publisher pose_pub_, path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
+  // Pose, odometry and tf. Used by the frame callback; the map timer reads its frames and
+  // mount only once system_ exists, i.e. after the frame callback resolved the mount (the
+  // mount is written once, before system_ is created under system_mutex_).
+  std::unique_ptr<PoseOutput> pose_out_;
+  ::ros::Publisher path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
   ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_;
   ::ros::WallTimer map_timer_, diag_timer_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
-  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
 };
 
 }  // namespace ros1

@@ -221,6 +221,7 @@ MapFileInfo System::loadMap(const std::string& path) {
     tracker_->startInLoadedMap();
     map_->adopt(*loaded);
   }
+  ++maps_loaded_;
   resumeBackEnd();
   return info;
 }
@@ -338,6 +339,17 @@ SystemStats System::stats() const {
   s.loops_closed = loops;
   s.global_bas = gbas;
   return s;
+}
+
+size_t System::mapCorrections() const {
+  size_t n = 0;
+  {
+    std::lock_guard<std::mutex> tl(track_mutex_);
+    n += tracker_->relocalizations() + maps_loaded_;
+  }
+  if (loop_closer_) n += loop_closer_->loopsClosed() + loop_closer_->globalBundleAdjustments();
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  return n + stats_.resets;
 }
 
 BoxCounts& BoxCounts::operator+=(const BoxCounts& o) {

@@ -11,11 +11,16 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/Odometry.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -35,7 +40,13 @@ namespace {
 
 std::mutex g_mutex;  // guards everything below (subscriber threads vs test thread)
 std::vector<double> g_pose_wall;  // wall time of each pose message
-size_t g_path_len = 0, g_cloud_points = 0, g_markers = 0, g_debug_images = 0;
+size_t g_path_len = 0, g_cloud_points = 0, g_markers = 0, g_debug_images = 0, g_pose_cov = 0;
+// nav_msgs/Odometry: messages, the largest step between two (REP 105: odom is continuous),
+// and whether every one had the expected frames.
+size_t g_odom = 0;
+double g_odom_max_step = 0;
+bool g_odom_frames_ok = true;
+geometry_msgs::Point g_odom_last;
 std::map<std::string, std::map<std::string, std::string>> g_diag;  // status name -> key -> value
 
 int run(const std::string& cmd) {
@@ -88,6 +99,22 @@ TEST(FullGraph, SyntheticWalkingBag) {
   pnh.param<std::string>("tum_to_bag", script, "");
   pnh.param<std::string>("rviz_config", rviz_config, "");
   pnh.param<std::string>("screenshot", screenshot, "/tmp/yolo_slam_rviz.png");
+  // The Slam nodelet started without ~base_to_camera: it must read base -> camera from tf, which
+  // this test publishes as a robot's URDF would (static, before any frame).
+  bool mount_from_tf = false;
+  pnh.param("mount_from_tf", mount_from_tf, false);
+  tf2_ros::StaticTransformBroadcaster mount_broadcaster;
+  if (mount_from_tf) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = "base_link";
+    t.child_frame_id = "openni_rgb_optical_frame";
+    t.transform.rotation.x = -0.5;
+    t.transform.rotation.y = 0.5;
+    t.transform.rotation.z = -0.5;
+    t.transform.rotation.w = 0.5;
+    mount_broadcaster.sendTransform(t);
+  }
   ASSERT_FALSE(script.empty()) << "~tum_to_bag not set";
 
   char tmpl[] = "/tmp/yolo_slam_full_graph_XXXXXX";
@@ -101,6 +128,21 @@ TEST(FullGraph, SyntheticWalkingBag) {
       "/yolo_slam/pose", 1000, +[](const geometry_msgs::PoseStamped::ConstPtr&) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_pose_wall.push_back(ros::WallTime::now().toSec());
+      });
+  ros::Subscriber pose_cov_sub = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+      "/yolo_slam/pose_with_covariance", 1000, +[](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        if (m->pose.covariance[0] > 0 && m->pose.covariance[35] > 0 && m->header.frame_id == "map") ++g_pose_cov;
+      });
+  ros::Subscriber odom_sub = nh.subscribe<nav_msgs::Odometry>(
+      "/yolo_slam/odom", 1000, +[](const nav_msgs::Odometry::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_odom_frames_ok = g_odom_frames_ok && m->header.frame_id == "odom" && m->child_frame_id == "base_link";
+        const auto& p = m->pose.pose.position;
+        if (g_odom > 0)
+          g_odom_max_step = std::max(g_odom_max_step, std::hypot(p.x - g_odom_last.x, p.y - g_odom_last.y, p.z - g_odom_last.z));
+        g_odom_last = p;
+        ++g_odom;
       });
   ros::Subscriber path_sub = nh.subscribe<nav_msgs::Path>(
       "/yolo_slam/path", 10, +[](const nav_msgs::Path::ConstPtr& m) {
@@ -219,6 +261,17 @@ TEST(FullGraph, SyntheticWalkingBag) {
   EXPECT_EQ(parent, "base_link");
   EXPECT_TRUE(tf_buffer._getParent("base_link", ros::Time(0), parent));
   EXPECT_EQ(parent, "odom");
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    std::printf("[full_graph] odometry %zu messages, largest step %.3f m; %zu poses with covariance\n", g_odom,
+                g_odom_max_step, g_pose_cov);
+    EXPECT_GT(g_odom, 0u);
+    EXPECT_TRUE(g_odom_frames_ok) << "nav_msgs/Odometry must be odom -> base_link";
+    // The camera moves at most a few cm per frame on this path: a jump would be a map correction
+    // leaking into odom.
+    EXPECT_LT(g_odom_max_step, 0.15);
+    EXPECT_GT(g_pose_cov, 0u);
+  }
 
   // Trajectory through the service, evaluated against the ground truth.
   yolo_slam::SaveTrajectory srv;

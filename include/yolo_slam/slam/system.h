@@ -146,6 +146,10 @@ class System {
   // Timing of the detector, measured by the caller that runs it (reported in the stats).
   void recordDetectionTime(double ms);
   TrackingState state() const;
+  // Grows whenever the map's frame may have jumped under the camera: a reset, a map load, a
+  // relocalisation, a loop closure or a global BA written back. Poses of two frames between
+  // which it did not change differ by tracked motion only (slam::ContinuousOdometry).
+  size_t mapCorrections() const;
   // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
   // screener), e.g. for screening metrics against ground truth; empty before the first frame.
   features::FeatureFrame lastFrame() const;
@@ -196,6 +200,7 @@ class System {
   mutable std::mutex stats_mutex_;
   SystemStats stats_;
   bool shut_down_ = false;
+  size_t maps_loaded_ = 0;  // guarded by track_mutex_
   std::atomic<bool> localization_only_{false};
   // Guards last_frame_ (taken alone, never while holding another of the mutexes above).
   mutable std::mutex last_frame_mutex_;
