@@ -20,6 +20,8 @@ DEPENDENCIES='
   visualization_msgs: libvisualization-msgs-dev python3-visualization-msgs
   diagnostic_msgs:    libdiagnostic-msgs-dev python3-diagnostic-msgs
   tf2_ros:            libtf2-ros-dev python3-tf2-ros
+  tf2_eigen:          libtf2-eigen-dev
+  cv_bridge:          libcv-bridge-dev
   message_filters:    libmessage-filters-dev
   libopencv-dev:      libopencv-dev
   eigen:              libeigen3-dev

@@ -2,6 +2,7 @@
 // REP 103 / REP 105 (pose_output.h); also the path, the static map points, keyframes with
 // covisibility edges and a debug image; services reset, save_trajectory (TUM format),
 // set_localization_mode, save_map and load_map (map files).
+#include <cv_bridge/cv_bridge.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -246,14 +247,7 @@ class SlamNodelet : public nodelet::Nodelet {
     cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3);
     cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
                 cv::Scalar(255, 255, 255), 1);
-    auto out = boost::make_shared<sensor_msgs::Image>();
-    out->header = msg.header;
-    out->width = img.cols;
-    out->height = img.rows;
-    out->encoding = sensor_msgs::image_encodings::BGR8;
-    out->step = img.cols * 3;
-    out->data.assign(img.data, img.data + img.total() * 3);
-    debug_pub_.publish(out);
+    debug_pub_.publish(cv_bridge::CvImage(msg.header, sensor_msgs::image_encodings::BGR8, img).toImageMsg());
   }
 
   void publishMap() {
