@@ -87,7 +87,7 @@ const std::set<std::string> kIncludeNoKey = {"sys", "yolo_slam"};
 const std::map<std::string, std::string> kPythonKey = {
     {"rospy", "rospy"}, {"rosbag", "rosbag"}, {"tf2_msgs", "tf2_msgs"}, {"cv2", "python3-opencv"},
     {"numpy", "python3-numpy"}, {"sensor_msgs", "sensor_msgs"}, {"geometry_msgs", "geometry_msgs"},
-    {"diagnostic_msgs", "diagnostic_msgs"}};
+    {"diagnostic_msgs", "diagnostic_msgs"}, {"nav_msgs", "nav_msgs"}, {"tf2_ros", "tf2_ros"}};
 const std::set<std::string> kPythonStdlib = {"argparse", "collections", "json", "math", "os", "re",
                                              "statistics", "sys", "xml", "subprocess", "time", "glob",
                                              "shutil", "struct", "tempfile", "itertools", "functools", "signal"};
