@@ -52,6 +52,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("use_boxes", use_boxes_, true);
     pnh.param("use_camera_info", use_camera_info_, true);
     pnh.param("depth_factor_16u", depth_factor_16u_, 1000.0);
+    pnh.param("assume_registered", assume_registered_, false);
     double max_interval = 0.05;
     pnh.param("sync_max_interval", max_interval, 0.05);
     try {
@@ -156,6 +157,23 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
 
+  // Depth must be registered to colour (pixel for pixel). A driver marks registered depth with
+  // the colour frame id (openni2_launch's depth_registered topics); plain depth/ topics carry
+  // the depth camera's frame and would be screened wrongly without a word.
+  void checkRegistered(const Image& rgb, const Image& depth) const {
+    if (assume_registered_) return;
+    auto bare = [](std::string f) {
+      while (!f.empty() && f.front() == '/') f.erase(0, 1);
+      return f;
+    };
+    if (bare(rgb.header.frame_id) == bare(depth.header.frame_id)) return;
+    throw Error("depth on " + depth_sub_.getTopic() + " is in frame '" + depth.header.frame_id + "', colour on " +
+                rgb_sub_.getTopic() + " in '" + rgb.header.frame_id +
+                "': depth is not registered to colour. Use the driver's registered depth (openni2_launch: "
+                "depth_registered:=true, topic camera/depth_registered/image_raw), or set ~assume_registered true "
+                "if the images are registered under other frame names (TUM bags)");
+  }
+
   void process(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const BoundingBoxes::ConstPtr& boxes_msg) {
     size_t dropped_now = 0;
@@ -179,6 +197,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       bool is_rgb = true;
       const cv::Mat image = imageView(*rgb, rgb_sub_.getTopic(), is_rgb);
       const cv::Mat depth_m = depthToMetres(*depth, depth_sub_.getTopic(), depth_factor_16u_);
+      checkRegistered(*rgb, *depth);
       if (depth_m.size() != image.size())
         throw Error("depth image on " + depth_sub_.getTopic() + " is " +
                     std::to_string(depth_m.cols) + "x" + std::to_string(depth_m.rows) +
@@ -277,6 +296,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
   std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
+  bool assume_registered_ = false;  // skip the depth/colour frame id check
   // Extraction and screening (stateful between frames; used by the frame callback only, which
   // the synchroniser serialises, like index_).
   std::unique_ptr<frontend::FrontEnd> front_end_;
