@@ -19,6 +19,7 @@ DEPENDENCIES='
   nav_msgs:           libnav-msgs-dev python3-nav-msgs
   visualization_msgs: libvisualization-msgs-dev python3-visualization-msgs
   diagnostic_msgs:    libdiagnostic-msgs-dev python3-diagnostic-msgs
+  diagnostic_updater: libdiagnostic-updater-dev
   tf2_ros:            libtf2-ros-dev python3-tf2-ros
   tf2_eigen:          libtf2-eigen-dev
   cv_bridge:          libcv-bridge-dev
