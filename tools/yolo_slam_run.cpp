@@ -49,11 +49,10 @@ namespace {
 // Written by the signal handler only, read by the main thread (sig_atomic_t, no lock).
 volatile std::sig_atomic_t g_stop = 0;     // number of the first stop signal; 0 while none came
 volatile std::sig_atomic_t g_signals = 0;  // stop signals received
-// Written by the main thread, read by the handler: 1 while the results are being written.
-volatile std::sig_atomic_t g_writing = 0;
 
-// While the results are written, the signal that forces a quit without them (the first stops
-// the run, the second is ignored: a writer interrupted 50 ms in would lose the whole run).
+// The signal that quits at once without the results. The first stops the run and has the
+// results written; the second is only acknowledged, since an impatient second Ctrl-C 50 ms
+// later, while they are being written, must not lose the whole run.
 constexpr int kForceQuitSignal = 3;
 constexpr int kExitError = 1;
 constexpr int kExitTooFewTracked = 3;
@@ -68,8 +67,8 @@ void onStopSignal(int sig) {
     g_stop = sig;
     return;
   }
-  if (g_writing && g_signals < kForceQuitSignal) {
-    static const char msg[] = "\nyolo_slam_run: still writing the results; one more signal quits without them\n";
+  if (g_signals < kForceQuitSignal) {
+    static const char msg[] = "\nyolo_slam_run: stopping and writing the results; one more signal quits without them\n";
     (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
     return;
   }
@@ -117,8 +116,8 @@ const char* kUsage =
     "While it runs, OUT/CameraTrajectory.partial.txt gets every tracking pose as it is estimated\n"
     "(kept after a kill or crash) and stats.json says \"complete\": false until the end.\n"
     "Ctrl-C, SIGTERM or SIGHUP stops at the next frame and still writes everything (exit code\n"
-    "128 + signal: 130 for Ctrl-C); a second one quits at once, except while the results are\n"
-    "being written (then the third does). Exit code 3: fewer frames tracked than --min-tracked\n"
+    "128 + signal: 130 for Ctrl-C); a second one is ignored, a third quits at once without them\n"
+    "(the partial trajectory stays). Exit code 3: fewer frames tracked than --min-tracked\n"
     "(everything is still written); 1: bad arguments, unreadable input, unwritable output.\n"
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
@@ -777,7 +776,7 @@ Outcome outcomeOf(const Args& args, const LoopResult& res, const slam::SystemSta
     o.status = "interrupted";
     o.reason = "stopped by " + signalName(g_stop) + " after " + std::to_string(o.frames) + " frames";
     o.exit_code = kExitSignalBase + g_stop;
-  } else if (o.tracked_fraction < args.min_tracked || o.tracked == 0) {
+  } else if (o.tracked_fraction < args.min_tracked) {
     o.status = "too few frames tracked";
     char buf[96];
     std::snprintf(buf, sizeof buf, " (below --min-tracked %g)", args.min_tracked);
@@ -943,7 +942,7 @@ int finishRun(const Args& args, const RunSetup& setup, slam::System& system, Par
   outputs.trajectory->remove();
   printSummary(setup, res, ate, s);
   std::printf("wrote %s/{%s,%s,%s%s}\n", args.out.c_str(), io::RunFiles::kCameraTrajectory,
-              io::RunFiles::kKeyFrameTrajectory, boxes_written ? "boxes_screened.txt," : "", io::RunFiles::kStats);
+              io::RunFiles::kKeyFrameTrajectory, boxes_written ? (std::string(io::RunFiles::kBoxesScreened) + ",").c_str() : "", io::RunFiles::kStats);
   if (outcome.exit_code == kExitTooFewTracked)
     std::fprintf(stderr, "error: %s; everything is written to %s (exit code %d; --min-tracked 0 accepts such a run)\n",
                  outcome.reason.c_str(), args.out.c_str(), kExitTooFewTracked);
@@ -971,7 +970,6 @@ int run(const Args& args) {
                setup.has_masks ? ", screening metrics from masks/" : "");
 
   const LoopResult res = processFrames(args, setup, system, outputs);
-  g_writing = 1;
   if (g_stop)
     std::fprintf(stderr, "interrupted by %s: stopping after %zu frames and writing the results\n",
                  signalName(g_stop).c_str(), res.processed + res.skipped);
