@@ -840,8 +840,7 @@ struct FinalStats {
 };
 
 Json trackingJson(const Args& args, const FinalStats& f) {
-  return Json{{"frames", f.outcome.frames},
-              {"tracked", f.outcome.tracked},
+  return Json{{"frames_read", f.outcome.frames},
               {"tracked_fraction", jsonNumber(f.outcome.tracked_fraction)},
               {"min_tracked", args.min_tracked},
               {"untracked", f.res.untracked.json()}};

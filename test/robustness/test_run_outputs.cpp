@@ -91,7 +91,7 @@ TEST_F(RunOutputs, AFinishedRunLeavesExactlyItsFilesAndSaysComplete) {
   EXPECT_EQ(js["status"], "finished") << js.dump();
   EXPECT_EQ(js["files"]["camera_trajectory"], "CameraTrajectory.txt") << js.dump();
   EXPECT_TRUE(js["files"]["boxes_screened"].is_null()) << js.dump();
-  EXPECT_EQ(js["tracking"]["frames"], kFrames) << js.dump();
+  EXPECT_EQ(js["tracking"]["frames_read"], kFrames) << js.dump();
   EXPECT_EQ(js["trajectory_poses"], poseLines(joinPath(out, "CameraTrajectory.txt"))) << js.dump();
 }
 
