@@ -613,7 +613,8 @@ struct PartialOutputs {
 };
 
 bool depthUnusable(const Prepared& p) {
-  return p.depth.empty() || p.depth.size() != p.bgr.size() || cv::countNonZero(p.depth > 0) == 0;
+  return p.depth.empty() || p.depth.channels() != 1 || p.depth.size() != p.bgr.size() ||
+         cv::countNonZero(p.depth > 0) == 0;
 }
 
 // The first frame of each kind gets a warning; the rest are counted for the summary.
