@@ -29,6 +29,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -46,9 +47,11 @@ using namespace yolo_slam;
 
 namespace {
 
-// Written by the signal handler only, read by the main thread (sig_atomic_t, no lock).
-volatile std::sig_atomic_t g_stop = 0;     // number of the first stop signal; 0 while none came
-volatile std::sig_atomic_t g_signals = 0;  // stop signals received
+// Written by the signal handler only, read by the frame loop and the waits. Lock-free atomics:
+// the handler may run in any thread, several at once when signals arrive together.
+std::atomic<int> g_stop{0};     // number of the first stop signal; 0 while none came
+std::atomic<int> g_signals{0};  // stop signals received
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
 
 // The signal that quits at once without the results. The first stops the run and has the
 // results written; the second is only acknowledged, since an impatient second Ctrl-C 50 ms
@@ -59,15 +62,14 @@ constexpr int kExitTooFewTracked = 3;
 constexpr int kExitSignalBase = 128;  // 128 + signal number, as a shell reports it
 constexpr double kDefaultMinTracked = 0.1;
 
-// The handler, async-signal-safe: flags, write(2) and _exit only. It runs with every stop
-// signal blocked (sigaction's mask), so the counter is never raced.
+// The handler, async-signal-safe: lock-free atomics, write(2) and _exit only.
 void onStopSignal(int sig) {
-  g_signals = g_signals + 1;
-  if (g_signals == 1) {
+  const int n = g_signals.fetch_add(1) + 1;
+  if (n == 1) {
     g_stop = sig;
     return;
   }
-  if (g_signals < kForceQuitSignal) {
+  if (n < kForceQuitSignal) {
     static const char msg[] = "\nyolo_slam_run: stopping and writing the results; one more signal quits without them\n";
     (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
     return;

@@ -179,9 +179,5 @@ bool waitFor(Pred ready, int timeout_s = kRunTimeoutS) {
   return true;
 }
 
-// The line yolo_slam_run prints once its signal handlers are in and its folder is claimed,
-// right before the first frame.
-inline bool started(const Child& c) { return c.err().find("yolo_slam_run: ") != std::string::npos; }
-
 }  // namespace robustness
 }  // namespace yolo_slam

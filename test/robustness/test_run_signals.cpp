@@ -1,7 +1,8 @@
 // yolo_slam_run under signals (issue 22, defect 2): the tracking poses are on disk while the
 // run goes on (SIGKILL keeps them, stats.json says the run did not finish), SIGHUP and SIGTERM
 // write the results like SIGINT (exit 128 + signal), a second Ctrl-C right after the first
-// does not abort the final write, and a closed output pipe (SIGPIPE) does not end the run.
+// does not abort the final write while a third quits at once, and a closed output pipe
+// (SIGPIPE) does not end the run.
 #include "yolo_slam/io/trajectory.h"
 
 #include "run_tool.h"
@@ -104,6 +105,22 @@ TEST_F(RunSignals, ASecondCtrlCDoesNotAbortTheFinalWrite) {
   std::this_thread::sleep_for(kSecondSignalDelay);
   ::kill(c.pid, SIGINT);
   expectInterruptedResults(c, waitExit(c), out, "SIGINT", SIGINT);
+}
+
+TEST_F(RunSignals, AThirdSignalQuitsAtOnceKeepingThePartialTrajectory) {
+  const std::string out = tree_->path("out_three");
+  Child c = startMidRun(out, "three");
+  // Three different signals while the child is stopped are all pending when it continues, so
+  // they arrive before it can write anything (one signal of a kind would be merged).
+  ::kill(c.pid, SIGSTOP);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::kill(c.pid, sig);
+  ::kill(c.pid, SIGCONT);
+  const int rc = waitExit(c);
+  EXPECT_TRUE(rc == 128 + SIGINT || rc == 128 + SIGTERM || rc == 128 + SIGHUP) << rc << "\n" << c.err();
+  EXPECT_NE(c.err().find("quitting at once"), std::string::npos) << c.err();
+  EXPECT_GE(poseLines(partialOf(out)), kPosesBeforeSignal);
+  EXPECT_FALSE(fileExists(joinPath(out, "CameraTrajectory.txt")));
+  EXPECT_EQ(statsOf(out)["status"], "running");
 }
 
 TEST_F(RunSignals, AClosedOutputPipeDoesNotEndTheRun) {
