@@ -943,8 +943,9 @@ int finishRun(const Args& args, const RunSetup& setup, slam::System& system, Par
   io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(runStatsJson(args, setup, stats)));
   outputs.trajectory->remove();
   printSummary(setup, res, ate, s);
+  const std::string boxes_name = boxes_written ? std::string(io::RunFiles::kBoxesScreened) + "," : "";
   std::printf("wrote %s/{%s,%s,%s%s}\n", args.out.c_str(), io::RunFiles::kCameraTrajectory,
-              io::RunFiles::kKeyFrameTrajectory, boxes_written ? (std::string(io::RunFiles::kBoxesScreened) + ",").c_str() : "", io::RunFiles::kStats);
+              io::RunFiles::kKeyFrameTrajectory, boxes_name.c_str(), io::RunFiles::kStats);
   if (outcome.exit_code == kExitTooFewTracked)
     std::fprintf(stderr, "error: %s; everything is written to %s (exit code %d; --min-tracked 0 accepts such a run)\n",
                  outcome.reason.c_str(), args.out.c_str(), kExitTooFewTracked);

@@ -98,8 +98,10 @@ void IncrementalFile::append(const std::string& text) {
   if (!file_) return;
   const bool ok = std::fwrite(text.data(), 1, text.size(), file_.get()) == text.size() && std::fflush(file_.get()) == 0;
   if (ok) return;
-  std::fprintf(stderr, "\nwarning: %s: write failed (%s); it is no longer updated (the final files are still written at the end)\n",
-               path_.c_str(), std::strerror(errno));
+  std::fprintf(
+      stderr,
+      "\nwarning: %s: write failed (%s); it is no longer updated (the final files are still written at the end)\n",
+      path_.c_str(), std::strerror(errno));
   file_.reset();
   failed_ = true;
 }

@@ -45,7 +45,8 @@ TEST(Playback, SleepEndsOnAStopRequest) {
 
 TEST(Playback, CameraFeedWaitEndsOnAStopRequest) {
   // The second frame is due an hour later without the cap; with it, still far beyond the stop.
-  io::CameraFeed<int> feed({0.0, 3600.0}, [](size_t i) { return static_cast<int>(i); }, 3600.0);
+  io::CameraFeed<int> feed(
+      {0.0, 3600.0}, [](size_t i) { return static_cast<int>(i); }, 3600.0);
   ASSERT_TRUE(feed.next().has_value());
   std::atomic<bool> stop{false};
   std::thread signaller([&] {
@@ -57,7 +58,8 @@ TEST(Playback, CameraFeedWaitEndsOnAStopRequest) {
 }
 
 TEST(Playback, CameraFeedCapsALongGap) {
-  io::CameraFeed<int> feed({0.0, 0.01, 3600.0}, [](size_t i) { return static_cast<int>(i); }, 0.05);
+  io::CameraFeed<int> feed(
+      {0.0, 0.01, 3600.0}, [](size_t i) { return static_cast<int>(i); }, 0.05);
   size_t got = 0;
   while (feed.next()) ++got;  // would take an hour without the cap
   EXPECT_EQ(got + static_cast<size_t>(feed.dropped()), 3u);

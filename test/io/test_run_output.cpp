@@ -58,17 +58,27 @@ TEST_F(RunOutputTest, FolderIsCreatedAndProbedWithoutLeavingAFile) {
 }
 
 TEST_F(RunOutputTest, UnwritableOrBlockedOutputsAreRefusedNamingThePath) {
-  EXPECT_EQ(errorOf([] { io::prepareOutputFolder("/proc", {"x.txt"}, "--out"); }).rfind("/proc: the output folder is not writable", 0), 0u);
+  EXPECT_EQ(errorOf([] {
+              io::prepareOutputFolder("/proc", {"x.txt"}, "--out");
+            }).rfind("/proc: the output folder is not writable", 0),
+            0u);
   std::ofstream(path("file")) << "x";
-  EXPECT_NE(errorOf([&] { io::prepareOutputFolder(path("file"), {}, "--out"); }).find("--out names a file"), std::string::npos);
-  EXPECT_NE(errorOf([&] { io::prepareOutputFolder(path("file/sub"), {}, "--out"); }).find("cannot create the output folder"),
+  EXPECT_NE(errorOf([&] { io::prepareOutputFolder(path("file"), {}, "--out"); }).find("--out names a file"),
             std::string::npos);
+  EXPECT_NE(
+      errorOf([&] { io::prepareOutputFolder(path("file/sub"), {}, "--out"); }).find("cannot create the output folder"),
+      std::string::npos);
   fs::create_directories(path("out/stats.json.tmp"));
   const std::string msg = errorOf([&] { io::prepareOutputFolder(path("out"), {"stats.json"}, "--out"); });
   EXPECT_EQ(msg.rfind(path("out/stats.json.tmp") + ": a folder has the name of an output file", 0), 0u) << msg;
-  EXPECT_EQ(errorOf([] { io::checkOutputFile("/proc/m.ysmap", "--save-map"); }).rfind("/proc/m.ysmap: --save-map folder /proc is not writable", 0), 0u);
-  EXPECT_NE(errorOf([&] { io::checkOutputFile(path("none/m.ysmap"), "--save-map"); }).find("does not exist"), std::string::npos);
-  EXPECT_NE(errorOf([&] { io::checkOutputFile(path("out"), "--save-map"); }).find("a folder has the name"), std::string::npos);
+  EXPECT_EQ(errorOf([] {
+              io::checkOutputFile("/proc/m.ysmap", "--save-map");
+            }).rfind("/proc/m.ysmap: --save-map folder /proc is not writable", 0),
+            0u);
+  EXPECT_NE(errorOf([&] { io::checkOutputFile(path("none/m.ysmap"), "--save-map"); }).find("does not exist"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { io::checkOutputFile(path("out"), "--save-map"); }).find("a folder has the name"),
+            std::string::npos);
   EXPECT_EQ(errorOf([&] { io::checkOutputFile(path("m.ysmap"), "--save-map"); }), "");
 }
 
@@ -89,7 +99,8 @@ TEST_F(RunOutputTest, IncrementalFileRemoveAndOpenFailure) {
   }
   EXPECT_FALSE(fileExists(path("y.partial")));
   fs::create_directories(path("blocked"));
-  EXPECT_NE(errorOf([&] { io::IncrementalFile g(path("blocked"), ""); }).find(path("blocked") + ": cannot create"), std::string::npos);
+  EXPECT_NE(errorOf([&] { io::IncrementalFile g(path("blocked"), ""); }).find(path("blocked") + ": cannot create"),
+            std::string::npos);
 }
 
 TEST_F(RunOutputTest, AtomicWriteNamesTheTemporaryInTheWay) {

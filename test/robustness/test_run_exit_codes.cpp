@@ -35,7 +35,8 @@ class RunExitCodes : public ::testing::Test {
   template <class Make>
   static std::string withImages(const std::string& name, const std::string& sub, Make make) {
     const std::string dir = tree_->copy(seq_, name);
-    for (const auto& e : fs::directory_iterator(joinPath(dir, sub))) EXPECT_TRUE(cv::imwrite(e.path().string(), make()));
+    for (const auto& e : fs::directory_iterator(joinPath(dir, sub)))
+      EXPECT_TRUE(cv::imwrite(e.path().string(), make()));
     return dir;
   }
 
@@ -107,7 +108,8 @@ TEST_F(RunExitCodes, AllBlackImagesExitThreeWithAWarning) {
 }
 
 TEST_F(RunExitCodes, WrongSizeDepthExitsThree) {
-  const std::string dir = withImages("small_depth", "depth", [] { return cv::Mat(240, 320, CV_16U, cv::Scalar(5000)); });
+  const std::string dir =
+      withImages("small_depth", "depth", [] { return cv::Mat(240, 320, CV_16U, cv::Scalar(5000)); });
   expectTooFewTracked(dir, std::to_string(kFrames) + " without usable depth", "small_depth");
 }
 
@@ -119,7 +121,8 @@ TEST_F(RunExitCodes, MinTrackedZeroAcceptsAnyRunAndBadValuesAreRefused) {
   EXPECT_EQ(runTool(runArgs(seq, tree_->path("out_black0"), {"--min-tracked", "0"}), tree_->path("black0"), err), 0)
       << err;
   for (const char* bad : {"-0.1", "1.5", "nan", "half"}) {
-    EXPECT_EQ(runTool(runArgs(seq_, tree_->path("out_bad"), {"--min-tracked", bad}), tree_->path("bad"), err), 1) << bad;
+    EXPECT_EQ(runTool(runArgs(seq_, tree_->path("out_bad"), {"--min-tracked", bad}), tree_->path("bad"), err), 1)
+        << bad;
     EXPECT_EQ(err.rfind("error: --min-tracked must be a fraction in [0, 1]", 0), 0u) << err;
   }
 }

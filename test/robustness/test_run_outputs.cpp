@@ -98,9 +98,10 @@ TEST_F(RunOutputs, AFinishedRunLeavesExactlyItsFilesAndSaysComplete) {
 TEST_F(RunOutputs, ScreenedBoxesAreRenamedIntoPlaceAtTheEnd) {
   const std::string out = tree_->path("out_boxes");
   std::string err;
-  ASSERT_EQ(runTool({"--sequence", seq_, "--out", out, "--no-vocabulary", "--dynamic-mode", "detect", "--boxes-from-gt"},
-                    tree_->path("boxes"), err),
-            0)
+  ASSERT_EQ(
+      runTool({"--sequence", seq_, "--out", out, "--no-vocabulary", "--dynamic-mode", "detect", "--boxes-from-gt"},
+              tree_->path("boxes"), err),
+      0)
       << err;
   EXPECT_EQ(filesIn(out), (std::vector<std::string>{"CameraTrajectory.txt", "KeyFrameTrajectory.txt",
                                                     "boxes_screened.txt", "stats.json"}));
