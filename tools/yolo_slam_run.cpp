@@ -816,11 +816,7 @@ Json runFilesJson(const Args& args, bool boxes_written) {
 // Takes the folder for this run before the first frame: the previous run's files go (a folder
 // never mixes two runs), stats.json says "running", and the partial files are opened.
 PartialOutputs claimRunFolder(const Args& args, const RunSetup& setup) {
-  for (const std::string& name : io::RunFiles::all()) {
-    const std::string path = joinPath(args.out, name);
-    io::removeFileIfPresent(io::temporaryPathOf(path));
-    if (name != io::RunFiles::kStats) io::removeFileIfPresent(path);
-  }
+  io::removePreviousRun(args.out);
   io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(runningStatsJson(args)));
   PartialOutputs p;
   p.trajectory = std::make_unique<io::IncrementalFile>(joinPath(args.out, io::RunFiles::kPartialTrajectory),

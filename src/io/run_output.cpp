@@ -85,6 +85,14 @@ void removeFileIfPresent(const std::string& path) {
                 "); remove it by hand or choose another output folder");
 }
 
+void removePreviousRun(const std::string& dir) {
+  for (const std::string& name : RunFiles::all()) {
+    const std::string path = joinPath(dir, name);
+    removeFileIfPresent(temporaryPathOf(path));
+    if (name != RunFiles::kStats) removeFileIfPresent(path);
+  }
+}
+
 IncrementalFile::IncrementalFile(std::string path, const std::string& header)
     : path_(std::move(path)), file_(std::fopen(path_.c_str(), "w"), &std::fclose) {
   if (!file_)

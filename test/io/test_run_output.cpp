@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -101,6 +102,19 @@ TEST_F(RunOutputTest, IncrementalFileRemoveAndOpenFailure) {
   fs::create_directories(path("blocked"));
   EXPECT_NE(errorOf([&] { io::IncrementalFile g(path("blocked"), ""); }).find(path("blocked") + ": cannot create"),
             std::string::npos);
+}
+
+TEST_F(RunOutputTest, APreviousRunsFilesAreRemovedButStatsAndOtherFilesKept) {
+  for (const std::string& name : io::RunFiles::all()) {
+    std::ofstream(path(name)) << "old";
+    std::ofstream(io::temporaryPathOf(path(name))) << "old";
+  }
+  std::ofstream(path("notes.txt")) << "mine";
+  io::removePreviousRun(dir_);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_)) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"notes.txt", "stats.json"}));
 }
 
 TEST_F(RunOutputTest, AtomicWriteNamesTheTemporaryInTheWay) {

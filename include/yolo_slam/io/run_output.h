@@ -36,6 +36,10 @@ void checkOutputFile(const std::string& path, const std::string& flag);
 // Removes the file `path` if there is one; Error naming it when it cannot be removed.
 void removeFileIfPresent(const std::string& path);
 
+// Removes the files of a previous run in `dir` (every RunFiles name and its temporary), except
+// stats.json, which the caller replaces atomically: a folder never mixes two runs.
+void removePreviousRun(const std::string& dir);
+
 // A text file written while a run goes on. Each append() is flushed to the kernel, so a kill
 // (SIGKILL, a crash) keeps every line appended before it (a power cut may lose the tail). A
 // failing write (disk full) warns once on stderr and the file is given up: the run goes on and
