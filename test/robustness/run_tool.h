@@ -95,6 +95,33 @@ class TempTree {
   std::string root_;
 };
 
+// A copy `name` of the sequence `from` whose stamps (rgb and depth of a row of
+// associations.txt, the list the runner reads) are `retime(row, stamp)`; groundtruth.txt is
+// dropped (its stamps no longer match).
+template <class Retime>
+std::string withStamps(const TempTree& tree, const std::string& from, const std::string& name, Retime retime) {
+  const std::string dir = tree.copy(from, name);
+  const std::string list = joinPath(dir, "associations.txt");
+  std::ifstream in(list);
+  std::ostringstream out;
+  int row = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream ss(line);
+    double rgb_t = 0, depth_t = 0;
+    std::string rgb, depth;
+    if (!(ss >> rgb_t >> rgb >> depth_t >> depth)) continue;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%.6f %s %.6f %s\n", retime(row, rgb_t), rgb.c_str(), retime(row, depth_t),
+                  depth.c_str());
+    out << buf;
+    ++row;
+  }
+  in.close();
+  std::ofstream(list) << out.str();
+  fs::remove(joinPath(dir, "groundtruth.txt"));
+  return dir;
+}
+
 // A started yolo_slam_run with stdout and stderr in files. A child not waited for (a failed
 // assertion returned early) is killed when this goes out of scope, never left running.
 struct Child {

@@ -60,25 +60,7 @@ std::string RunExitCodes::seq_;
 
 // The sequence with every stamp from frame kGapFrame on moved kGapS later.
 std::string withStampGap(const TempTree& tree, const std::string& seq) {
-  const std::string dir = tree.copy(seq, "gap");
-  const std::string list = joinPath(dir, "associations.txt");
-  std::ifstream in(list);
-  std::ostringstream shifted;
-  int row = 0;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream ss(line);
-    double rgb_t = 0, depth_t = 0;
-    std::string rgb, depth;
-    if (!(ss >> rgb_t >> rgb >> depth_t >> depth)) continue;
-    const double shift = row++ >= kGapFrame ? kGapS : 0.0;
-    char buf[512];
-    std::snprintf(buf, sizeof buf, "%.6f %s %.6f %s\n", rgb_t + shift, rgb.c_str(), depth_t + shift, depth.c_str());
-    shifted << buf;
-  }
-  in.close();
-  std::ofstream(list) << shifted.str();
-  fs::remove(joinPath(dir, "groundtruth.txt"));
-  return dir;
+  return withStamps(tree, seq, "gap", [](int row, double t) { return row >= kGapFrame ? t + kGapS : t; });
 }
 
 }  // namespace

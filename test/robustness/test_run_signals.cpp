@@ -14,6 +14,9 @@ namespace {
 
 // Poses on disk before a signal is sent: the run is past initialisation, mid-sequence.
 constexpr size_t kPosesBeforeSignal = 3;
+// The sequence played this many times slower than recorded: a few seconds at --realtime, so a
+// signal sent after the first poses lands mid-run even on a loaded machine.
+constexpr double kSlowDown = 4.0;
 // Between two signals (the reproduction: a second Ctrl-C 50 ms after the first).
 constexpr auto kSecondSignalDelay = std::chrono::milliseconds(50);
 
@@ -23,7 +26,11 @@ class RunSignals : public ::testing::Test {
   static std::string seq_;
   static void SetUpTestSuite() {
     tree_ = new TempTree("run_signals");
-    seq_ = tree_->generate("seq");
+    const std::string recorded = tree_->generate("recorded");
+    std::ifstream first(joinPath(recorded, "associations.txt"));
+    double t0 = 0;
+    first >> t0;
+    seq_ = withStamps(*tree_, recorded, "seq", [t0](int, double t) { return t0 + (t - t0) * kSlowDown; });
   }
   static void TearDownTestSuite() {
     delete tree_;
@@ -34,7 +41,7 @@ class RunSignals : public ::testing::Test {
   }
   static std::string partialOf(const std::string& out) { return joinPath(out, "CameraTrajectory.partial.txt"); }
 
-  // Starts a --realtime run (about a second of stamps) and waits until poses are on disk.
+  // Starts a --realtime run (a few seconds of stamps) and waits until poses are on disk.
   static Child startMidRun(const std::string& out, const std::string& log) {
     Child c = spawn(runArgs(seq_, out, {"--realtime"}), tree_->path(log));
     EXPECT_GT(c.pid, 0);
