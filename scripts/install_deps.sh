@@ -30,6 +30,7 @@ DEPENDENCIES='
   libopenni2-dev:     libopenni2-dev
   nlohmann-json-dev:  nlohmann-json3-dev
   libcereal-dev:      libcereal-dev
+  liboctomap-dev:     liboctomap-dev octomap-tools
   message_generation: ros-message-generation
   message_runtime:    ros-message-runtime
   roslaunch:          python3-roslaunch rosbash

@@ -25,6 +25,7 @@ SystemOptions SystemOptions::load(const Config& cfg) {
   o.orb = features::OrbOptions::load(cfg);
   o.screening = screening::ScreeningOptions::load(cfg);
   o.slam = SlamOptions::load(cfg);
+  o.dense = mapping::DenseMapOptions::load(cfg);
   o.sequential = cfg.getBool("System.sequential", o.sequential);
   return o;
 }
@@ -57,8 +58,17 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     mapper_->setLoopClosing(loop_closer_.get());
   }
   tracker_ = std::make_unique<Tracking>(cam_, opt_.tracking, *map_, mapper_.get(), voc_, pyr);
+  if (options.dense.enabled) {
+    // Poses change when a loop is closed or a global BA is written back.
+    auto version = [this] {
+      return loop_closer_ ? static_cast<long>(loop_closer_->loopsClosed() + loop_closer_->globalBundleAdjustments()) : 0L;
+    };
+    dense_ = std::make_unique<mapping::DenseMapper>(cam_, options.dense, screening_options_,
+                                                    run_mode_ == RunMode::Threaded, version);
+  }
   mapper_->start();
   if (loop_closer_) loop_closer_->start();
+  if (dense_) dense_->start();
 }
 
 System::~System() { shutdown(); }
@@ -76,6 +86,7 @@ void System::shutdown() {
     loop_closer_->stop();
   }
   mapper_->stop();
+  if (dense_) dense_->stop();
 }
 
 namespace {
@@ -117,9 +128,49 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
     last_frame_ = fe.frame;
-    last_boxes_ = std::move(fe.boxes);
+    last_boxes_ = fe.boxes;
   }
-  return trackFeatures(fe.frame);
+  const TrackResult res = trackFeatures(fe.frame);
+  addDenseKeyFrame(res, image, usableDepth(depth_m, image, stamp), fe.boxes);
+  return res;
+}
+
+namespace {
+// T_wc of a keyframe now: through the spanning tree when it was culled, nullopt when the
+// keyframe is gone (map reset or replaced).
+mapping::PoseGetter keyFramePose(const KeyFramePtr& kf, Map& map) {
+  std::weak_ptr<KeyFrame> weak = kf;
+  return [weak, &map]() -> std::optional<Pose> {
+    const KeyFramePtr k = weak.lock();
+    if (!k) return std::nullopt;
+    std::lock_guard<std::mutex> ml(map.update_mutex);
+    Pose T_kr;
+    const KeyFramePtr live = liveAncestor(k, &T_kr);
+    if (!live) return std::nullopt;
+    return (T_kr * live->Tcw()).inverse();
+  };
+}
+}  // namespace
+
+void System::addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
+                              const detection::Boxes& boxes) {
+  if (!dense_ || !res.keyframe_inserted || depth_m.empty()) return;
+  KeyFramePtr kf;
+  {
+    std::lock_guard<std::mutex> tl(track_mutex_);
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    kf = tracker_->lastKeyFrame();
+  }
+  if (!kf) return;
+  mapping::DenseKeyFrame d;
+  d.id = kf->id;
+  d.stamp = kf->f.stamp;
+  d.pose = keyFramePose(kf, *map_);
+  d.image = image.clone();
+  d.depth_m = depth_m.clone();
+  d.boxes = boxes;
+  dense_->insert(std::move(d));
+  if (run_mode_ == RunMode::Sequential) dense_->processQueued();
 }
 
 TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
@@ -188,6 +239,7 @@ void System::resetInternal(bool keep_trajectory) {
     }
     map_->clear();
   }
+  if (dense_) dense_->clear();
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     ++stats_.resets;
@@ -222,6 +274,7 @@ MapFileInfo System::loadMap(const std::string& path) {
     map_->adopt(*loaded);
   }
   ++maps_loaded_;
+  if (dense_) dense_->clear();
   resumeBackEnd();
   return info;
 }

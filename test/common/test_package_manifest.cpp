@@ -80,7 +80,8 @@ std::string concatSources(std::initializer_list<const char*> dirs, std::initiali
 const std::map<std::string, std::string> kIncludeKey = {
     {"ros", "roscpp"}, {"opencv2", "libopencv-dev"}, {"Eigen", "eigen"},
     {"ceres", "libceres-dev"}, {"openni2", "libopenni2-dev"}, {"gtest", "gtest"},
-    {"nlohmann", "nlohmann-json-dev"}, {"cereal", "libcereal-dev"}};
+    {"nlohmann", "nlohmann-json-dev"}, {"cereal", "libcereal-dev"},
+    {"octomap", "liboctomap-dev"}};
 // Include prefixes that need no key: the C library and the project itself.
 const std::set<std::string> kIncludeNoKey = {"sys", "yolo_slam"};
 // Python modules imported by scripts and benchmarks that need a key; the standard library needs none.

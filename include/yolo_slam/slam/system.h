@@ -9,6 +9,7 @@
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/frontend/front_end.h"
+#include "yolo_slam/mapping/dense_mapper.h"
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/map_file.h"
 #include "yolo_slam/slam/options.h"
@@ -85,6 +86,7 @@ struct SystemOptions {
   features::OrbOptions orb;              // ORBextractor.*
   screening::ScreeningOptions screening; // Screening.*
   SlamOptions slam;                      // Tracking.*, LocalMapping.*, LoopClosing.*
+  mapping::DenseMapOptions dense;        // DenseMap.*: the dense static map (off by default)
   // System.sequential: local mapping, loop closing and the global BA after a loop run in the
   // caller's thread right after each tracked frame, not in their own threads, so identical
   // input gives bit-identical output (slower: the caller waits for the back end).
@@ -114,6 +116,15 @@ class System {
                         const detection::Boxes& boxes, bool detector_ran = true);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
   TrackResult trackFeatures(const features::FeatureFrame& frame);
+  // Dense map (DenseMap.enabled): hands the keyframe the last trackFeatures made, with the
+  // frame's colour image, depth (CV_32F metres) and person boxes, to the dense mapper (copies
+  // them; the mapper masks and integrates in its own thread, or here when sequential). Call
+  // right after the trackFeatures whose result it gets; trackRgbd does. No-op unless
+  // res.keyframe_inserted and the dense map is on.
+  void addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
+                        const detection::Boxes& boxes);
+  // The dense mapper, null when DenseMap.enabled is 0. Complete (final poses) after shutdown().
+  const mapping::DenseMapper* denseMap() const { return dense_.get(); }
 
   void reset();
   void setLocalizationOnly(bool on);
@@ -190,6 +201,9 @@ class System {
   std::unique_ptr<LocalMapping> mapper_;
   std::unique_ptr<LoopClosing> loop_closer_;   // null without vocabulary or when disabled
   std::unique_ptr<Tracking> tracker_;
+  // Declared after map_ (destroyed first: its pose getters read the map's keyframes); stopped
+  // in shutdown() after local mapping and loop closing, so its final rebuild sees final poses.
+  std::unique_ptr<mapping::DenseMapper> dense_;
 
   // Serialises the tracking entry points (trackRgbd/trackFeatures/reset/setLocalizationOnly)
   // against each other; in sequential mode also the local mapping and loop closing they run
