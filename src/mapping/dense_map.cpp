@@ -51,6 +51,8 @@ constexpr unsigned kTreeDepth = 16;
 // Rough per-entry overhead of an unordered_map node beyond key and value (next pointer, hash).
 constexpr size_t kHashNodeOverhead = 16;
 constexpr uint8_t kGrey = 128;
+// Scans integrated lazily before the inner nodes are updated and the tree pruned.
+constexpr int kInnerUpdateInterval = 10;
 
 std::array<uint8_t, 3> pixelRgb(const cv::Mat& image, int u, int v, bool rgb_order) {
   if (image.empty()) return {kGrey, kGrey, kGrey};
@@ -134,6 +136,8 @@ void DenseMap::clear() {
   tree_->setProbHit(opt_.prob_hit);
   tree_->setProbMiss(opt_.prob_miss);
   cells_.clear();
+  inner_stale_ = false;
+  scans_since_inner_ = 0;
 }
 
 uint64_t DenseMap::cloudKey(const Eigen::Vector3f& p) const {
@@ -162,11 +166,23 @@ void DenseMap::integrate(const KeyFrameCloud& cloud, const Pose& T_wc) {
     const Eigen::Vector3f w = R * p + t;
     scan.push_back(w.x(), w.y(), w.z());
   }
-  // discretize: one ray per end voxel, the same map for a fraction of the ray casting.
-  tree_->insertPointCloud(scan, octomap::point3d(t.x(), t.y(), t.z()), opt_.max_range_m, false, true);
+  // discretize: one ray per end voxel, the same map for a fraction of the ray casting; lazy:
+  // inner nodes are updated once for many scans (half the cost of a scan).
+  tree_->insertPointCloud(scan, octomap::point3d(t.x(), t.y(), t.z()), opt_.max_range_m, true, true);
+  if (++scans_since_inner_ >= kInnerUpdateInterval) syncInner();
+  else inner_stale_ = true;
+}
+
+void DenseMap::syncInner() const {
+  if (!inner_stale_ && scans_since_inner_ == 0) return;
+  tree_->updateInnerOccupancy();
+  tree_->prune();
+  inner_stale_ = false;
+  scans_since_inner_ = 0;
 }
 
 std::vector<Voxel> DenseMap::occupiedLeaves() const {
+  syncInner();
   std::vector<Voxel> out;
   for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
     if (!tree_->isNodeOccupied(*it)) continue;
@@ -177,6 +193,7 @@ std::vector<Voxel> DenseMap::occupiedLeaves() const {
 }
 
 size_t DenseMap::occupiedVoxels() const {
+  syncInner();
   size_t n = 0;
   for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it)
     if (tree_->isNodeOccupied(*it)) n += size_t(1) << (3 * (kTreeDepth - it.getDepth()));
@@ -204,9 +221,13 @@ std::vector<Eigen::Vector3d> occupiedCentresOf(const octomap::OcTree& tree) {
 }
 }  // namespace
 
-std::vector<Eigen::Vector3d> DenseMap::occupiedCentres() const { return occupiedCentresOf(*tree_); }
+std::vector<Eigen::Vector3d> DenseMap::occupiedCentres() const {
+  syncInner();
+  return occupiedCentresOf(*tree_);
+}
 
 std::vector<ColouredPoint> DenseMap::cloud() const {
+  syncInner();
   std::vector<ColouredPoint> out;
   out.reserve(cells_.size());
   for (const auto& kv : cells_) {
@@ -223,11 +244,13 @@ std::vector<ColouredPoint> DenseMap::cloud() const {
 }
 
 size_t DenseMap::memoryBytes() const {
+  syncInner();
   const size_t cell = sizeof(uint64_t) + sizeof(CloudCell) + kHashNodeOverhead;
   return tree_->memoryUsage() + cells_.size() * cell + cells_.bucket_count() * sizeof(void*);
 }
 
 void DenseMap::writeOctomap(const std::string& path) const {
+  syncInner();
   std::ostringstream os;
   if (!tree_->writeBinaryConst(os)) throw Error(path + ": octomap could not serialise the tree");
   io::writeFileAtomic(path, os.str());

@@ -118,11 +118,16 @@ class DenseMap {
     uint32_t n = 0;
   };
   uint64_t cloudKey(const Eigen::Vector3f& p) const;
+  // Updates the inner nodes and prunes after lazy insertions; every output calls it first.
+  void syncInner() const;
 
   CameraModel cam_;
   DenseMapOptions opt_;
   std::unique_ptr<octomap::OcTree> tree_;
   std::unordered_map<uint64_t, CloudCell> cells_;
+  // Lazy insertion state: the tree (behind the pointer) is brought up to date by syncInner().
+  mutable bool inner_stale_ = false;
+  mutable int scans_since_inner_ = 0;
 };
 
 // Binary little-endian PLY (vertex x y z float, red green blue uchar). Throws yolo_slam::Error
