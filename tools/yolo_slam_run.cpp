@@ -107,6 +107,7 @@ const char* kUsage =
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
     "                     [--static-box-veto on|off] [--sequential] [--set KEY=VALUE ...]\n"
     "                     [--load-map FILE] [--save-map FILE] [--localization]\n"
+    "                     [--octomap OUT.bt] [--cloud OUT.ply]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -171,10 +172,14 @@ const char* kUsage =
     "                     \"map_file\" has its size and the save and load times\n"
     "  --localization     track against the map without adding keyframes or points (with\n"
     "                     --load-map: localisation in a prebuilt map)\n"
+    "  --octomap FILE     --set DenseMap.enabled=1 and write the dense static map (people left\n"
+    "                     out) as an OctoMap .bt file at the end; stats.json \"dense_map\"\n"
+    "  --cloud FILE       the same, and its coloured point cloud as binary PLY\n"
     "  -h, --help         this text\n";
 
 struct Args {
   std::string sequence, config, out, model, vocabulary, boxes_file, load_map, save_map;
+  std::string octomap, cloud;  // dense map outputs (--octomap, --cloud)
   // Settings overrides in command-line order (--set and the flags that stand for a key).
   std::vector<std::string> overrides;
   long max_frames = -1;
@@ -259,6 +264,8 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--load-map") a.load_map = need(i, s);
     else if (s == "--save-map") a.save_map = need(i, s);
     else if (s == "--localization") a.localization = true;
+    else if (s == "--octomap") a.octomap = need(i, s);
+    else if (s == "--cloud") a.cloud = need(i, s);
     else if (s == "-h" || s == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
@@ -273,6 +280,9 @@ Args parseArgs(int argc, char** argv) {
   if (a.realtime && a.camera_rate) throw Error("--realtime and --camera-rate exclude each other");
   // Outputs written at the end are checked now, not after the whole sequence.
   if (!a.save_map.empty()) io::checkOutputFile(a.save_map, "--save-map");
+  if (!a.octomap.empty()) io::checkOutputFile(a.octomap, "--octomap");
+  if (!a.cloud.empty()) io::checkOutputFile(a.cloud, "--cloud");
+  if (!a.octomap.empty() || !a.cloud.empty()) a.overrides.push_back("DenseMap.enabled=1");
   resolveDefaultFiles(a);
   return a;
 }
@@ -916,9 +926,26 @@ void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary
                 percent(m.dynamic_outside_dropped, m.dynamic_outside_boxes).c_str());
 }
 
+// The dense map's files (--octomap, --cloud) after shutdown, and its stats.json object (null
+// when the dense map is off).
+Json writeDenseMap(const Args& args, const slam::System& system) {
+  const mapping::DenseMapper* dense = system.denseMap();
+  if (!dense) return nullptr;
+  if (!args.octomap.empty()) dense->writeOctomap(args.octomap);
+  if (!args.cloud.empty()) dense->writeCloud(args.cloud);
+  const mapping::DenseMapStats d = dense->stats();
+  std::printf("dense map: %zu keyframes, %zu occupied voxels, %zu cloud points, %.1f MB\n", d.keyframes, d.voxels,
+              d.points, d.memory_bytes / (1024.0 * 1024.0));
+  Json j = d;
+  j["octomap"] = args.octomap.empty() ? Json(nullptr) : Json(args.octomap);
+  j["cloud"] = args.cloud.empty() ? Json(nullptr) : Json(args.cloud);
+  return j;
+}
+
 // The end of a run, in an order that a kill at any point leaves readable (README "What happens
 // when things go wrong"): the final trajectories (each atomic), the boxes renamed into place,
-// the map, then stats.json, the completion marker, and last the partial trajectory goes.
+// the map files (--save-map, then --octomap and --cloud), then stats.json, the completion
+// marker, and last the partial trajectory goes.
 int finishRun(const Args& args, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
               const LoopResult& res, MapFiles& maps) {
   system.waitForLocalMapping();
@@ -932,11 +959,14 @@ int finishRun(const Args& args, const RunSetup& setup, slam::System& system, Par
     std::printf("saved map %s: %zu keyframes, %zu points, %zu bytes in %.0f ms\n", args.save_map.c_str(),
                 maps.saved->keyframes, maps.saved->map_points, maps.saved->bytes, maps.saved->ms);
   }
+  const Json dense = writeDenseMap(args, system);
   const AteSummary ate = ateOf(setup.seq, traj);
   const slam::SystemStats s = system.stats();
   const Outcome outcome = outcomeOf(args, res, s);
   const FinalStats stats{outcome, res, traj.size(), ate, s, maps, boxes_written};
-  io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(runStatsJson(args, setup, stats)));
+  Json stats_json = runStatsJson(args, setup, stats);
+  if (!dense.is_null()) stats_json["dense_map"] = dense;
+  io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(stats_json));
   outputs.trajectory->remove();
   printSummary(setup, res, ate, s);
   const std::string boxes_name = boxes_written ? std::string(io::RunFiles::kBoxesScreened) + "," : "";
