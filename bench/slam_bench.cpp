@@ -17,14 +17,6 @@
 
 using namespace yolo_slam;
 
-namespace {
-double threadCpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-}  // namespace
-
 int main(int argc, char** argv) {
   try {
     std::string seq_dir, config, mode = "off";

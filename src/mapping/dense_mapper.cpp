@@ -25,6 +25,7 @@ void to_json(Json& j, const DenseMapStats& s) {
            {"memory_mb", jsonNumber(s.memory_bytes / kBytesPerMb)},
            {"mask_ms", summaryJsonMs(summarize(s.mask_ms))},
            {"integration_ms", summaryJsonMs(summarize(s.integration_ms))},
+           {"integration_cpu_ms", summaryJsonMs(summarize(s.integration_cpu_ms))},
            {"rebuild_ms", summaryJsonMs(summarize(s.rebuild_ms))}};
 }
 
@@ -143,11 +144,13 @@ void DenseMapper::processOne(DenseKeyFrame& kf) {
     std::lock_guard<std::mutex> lk(map_mutex_);
     if (kf.generation != generation_.load()) return;
     Stopwatch si;
+    const double cpu0 = threadCpuMs();
     map_.integrate(*cloud, *T_wc);
     kept_[kf.id] = Kept{kf.pose, cloud};
     ++stats_.keyframes;
     stats_.mask_ms.push_back(mask_ms);
     stats_.integration_ms.push_back(si.ms());
+    stats_.integration_cpu_ms.push_back(threadCpuMs() - cpu0);
   } catch (const Error& e) {
     std::fprintf(stderr, "warning: dense map: keyframe %ld (%.6f) not integrated: %s\n", kf.id, kf.stamp, e.what());
   }

@@ -44,6 +44,7 @@ DenseMapOptions testOptions() {
   DenseMapOptions o;
   o.enabled = true;
   o.resolution_m = 0.05;
+  o.max_range_m = 4.0;  // the wall at 3 m is within range off the optical axis too
   o.pixel_stride = 2;
   o.final_rebuild = false;
   return o;

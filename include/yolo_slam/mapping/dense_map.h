@@ -30,7 +30,9 @@ namespace mapping {
 
 struct DenseMapOptions {
   static constexpr double kDefaultResolutionM = 0.05;
-  static constexpr double kDefaultMaxRangeM = 4.0;
+  // Beyond 3 m the depth noise of a structured-light sensor exceeds a 5 cm voxel and free-space
+  // rays erase the far surfaces (docs/dense-map.md).
+  static constexpr double kDefaultMaxRangeM = 3.0;
   static constexpr int kDefaultPixelStride = 4;
   static constexpr double kDefaultCloudResolutionM = 0.02;
   static constexpr int kDefaultQueueSize = 8;

@@ -52,10 +52,11 @@ struct DenseMapStats {
   size_t voxels = 0;           // occupied, finest resolution
   size_t points = 0;           // coloured cloud (occupied voxels only)
   size_t memory_bytes = 0;     // octree + cloud voxels + kept keyframe clouds
-  std::vector<double> mask_ms, integration_ms, rebuild_ms;
+  // Wall times; integration_cpu_ms: the mapper thread's CPU time of the same integrations.
+  std::vector<double> mask_ms, integration_ms, integration_cpu_ms, rebuild_ms;
 };
 // {"keyframes", "dropped", "rebuilds", "voxels", "points", "memory_mb", "mask_ms" {...},
-//  "integration_ms" {...}, "rebuild_ms" {...}}
+//  "integration_ms" {...}, "integration_cpu_ms" {...}, "rebuild_ms" {...}}
 void to_json(Json& j, const DenseMapStats& s);
 
 class DenseMapper {
