@@ -205,8 +205,10 @@ Json runScore(const Args& a) {
     for (int v = dense.pixel_stride / 2; v < depth.rows; v += dense.pixel_stride)
       for (int u = dense.pixel_stride / 2; u < depth.cols; u += dense.pixel_stride) {
         const float d = depth.at<float>(v, u);
-        if (!(d > 0) || d > dense.max_range_m) continue;
-        const uint64_t key = voxelOf(T->T_wc * cam.unproject(u, v, d), res);
+        if (!(d > 0)) continue;
+        const Eigen::Vector3d pc = cam.unproject(u, v, d);
+        if (pc.norm() > dense.max_range_m) continue;  // the map's range along the ray
+        const uint64_t key = voxelOf(T->T_wc * pc, res);
         const uint8_t g = gt.at<uint8_t>(v, u);
         if (g == 255) person.insert(key);
         else if (g < kMaskDynamic) stat.insert(key);

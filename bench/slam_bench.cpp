@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     std::string seq_dir, config, mode = "off";
     long max_frames = -1;
     int n_features = 0;
+    std::vector<std::string> overrides;
     for (int i = 1; i < argc; ++i) {
       std::string s = argv[i];
       auto val = [&]() -> std::string {
@@ -33,11 +34,14 @@ int main(int argc, char** argv) {
       else if (s == "--max-frames") max_frames = std::atol(val().c_str());
       else if (s == "--features") n_features = std::atoi(val().c_str());
       else if (s == "--dynamic-mode") mode = val();
+      else if (s == "--set") overrides.push_back(val());
       else throw Error("unknown option '" + s + "'");
     }
     if (seq_dir.empty() || config.empty())
-      throw Error("usage: slam_bench --sequence DIR --config YAML [--max-frames N] [--features N] [--dynamic-mode M]");
+      throw Error("usage: slam_bench --sequence DIR --config YAML [--max-frames N] [--features N] [--dynamic-mode M] "
+                  "[--set KEY=VALUE ...]");
     Config cfg = Config::fromFile(config);
+    for (const auto& o : overrides) cfg.setFromAssignment(o);
     CameraModel cam = CameraModel::load(cfg);
     slam::SystemOptions opt = slam::SystemOptions::load(cfg);
     opt.screening.mode = screening::parseDynamicMode(mode);
@@ -66,6 +70,11 @@ int main(int argc, char** argv) {
     Summary e = summarize(st.extraction_ms), t = summarize(st.tracking_ms), lm = summarize(st.local_mapping_ms);
     std::printf("wall per stage (median): extraction %.2f ms, tracking %.2f ms, local mapping %.1f ms/keyframe\n",
                 e.median, t.median, lm.median);
+    if (const mapping::DenseMapper* dense = sys.denseMap()) {
+      const mapping::DenseMapStats d = dense->stats();
+      std::printf("dense map: %zu keyframes integrated, %zu dropped, integration median %.1f ms wall %.1f ms cpu\n",
+                  d.keyframes, d.dropped, summarize(d.integration_ms).median, summarize(d.integration_cpu_ms).median);
+    }
     if (seq.hasGroundTruth()) {
       Trajectory traj = sys.cameraTrajectory();
       if (traj.size() >= 2) std::printf("ATE RMSE %.4f m\n", eval::computeAte(seq.groundTruth(), traj).stats.rmse);

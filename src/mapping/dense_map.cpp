@@ -112,7 +112,8 @@ KeyFrameCloud backProject(const CameraModel& cam, const DenseMapOptions& o, cons
   c.rgb.reserve(px.size());
   for (size_t i = 0; i < px.size(); ++i) {
     const Eigen::Vector3f p = cam.unproject(und[i].x, und[i].y, depth[i]).cast<float>();
-    if (depth[i] > o.max_range_m) {
+    // Range along the ray, not depth: OctoMap's maxrange is a ray length.
+    if (p.norm() > o.max_range_m) {
       c.beyond.push_back(p);
       continue;
     }

@@ -30,9 +30,7 @@ namespace mapping {
 
 struct DenseMapOptions {
   static constexpr double kDefaultResolutionM = 0.05;
-  // Beyond 3 m the depth noise of a structured-light sensor exceeds a 5 cm voxel and free-space
-  // rays erase the far surfaces (docs/dense-map.md).
-  static constexpr double kDefaultMaxRangeM = 3.0;
+  static constexpr double kDefaultMaxRangeM = 4.0;
   static constexpr int kDefaultPixelStride = 4;
   static constexpr double kDefaultCloudResolutionM = 0.02;
   static constexpr int kDefaultQueueSize = 8;
@@ -41,8 +39,9 @@ struct DenseMapOptions {
 
   bool enabled = false;                              // DenseMap.enabled
   double resolution_m = kDefaultResolutionM;         // DenseMap.resolution: octree voxel edge
-  double max_range_m = kDefaultMaxRangeM;            // DenseMap.maxRange: farther depth only
-                                                     // carves free space up to this range
+  double max_range_m = kDefaultMaxRangeM;            // DenseMap.maxRange: range along the ray;
+                                                     // farther points only carve free space
+                                                     // up to it
   int pixel_stride = kDefaultPixelStride;            // DenseMap.pixelStride: every N-th pixel
                                                      // of every N-th row is integrated
   double cloud_resolution_m = kDefaultCloudResolutionM;  // DenseMap.cloudResolution
@@ -62,7 +61,7 @@ struct DenseMapOptions {
 
 // One keyframe's static depth in its camera frame, kept for re-integration after a pose change.
 struct KeyFrameCloud {
-  std::vector<Eigen::Vector3f> points;            // static pixels within max range
+  std::vector<Eigen::Vector3f> points;            // static pixels within max range (ray length)
   std::vector<std::array<uint8_t, 3>> rgb;        // their colour
   std::vector<Eigen::Vector3f> beyond;            // static pixels beyond max range: free space only
   size_t bytes() const;
