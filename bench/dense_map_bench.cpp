@@ -26,6 +26,8 @@
 #include "yolo_slam/mapping/static_mask.h"
 #include "yolo_slam/screening/screener.h"
 
+#include "gt_boxes.h"
+
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
@@ -36,6 +38,9 @@
 #include <vector>
 
 using namespace yolo_slam;
+using bench::kStampMatchS;
+using bench::readPersonBoxes;
+using bench::stampKey;
 
 namespace {
 
@@ -46,7 +51,6 @@ const char* const kUsage =
 constexpr uint8_t kMaskDynamic = 128;  // masks/: > 127 dynamic, 255 a person
 constexpr int kCoverageRadiusVoxels = 2;
 constexpr int kStaticToleranceVoxels = 1;
-constexpr double kStampMatchS = 1e-4;
 
 struct Args {
   std::string command, sequence, config, trajectory, octomap;
@@ -81,25 +85,6 @@ Config loadConfig(const Args& a) {
   Config cfg = Config::fromFile(a.config);
   for (const auto& o : a.overrides) cfg.setFromAssignment(o);
   return cfg;
-}
-
-long stampKey(double t) { return std::lround(t / kStampMatchS); }
-
-// Person boxes of boxes.txt by frame stamp.
-std::map<long, detection::Boxes> readPersonBoxes(const std::string& path) {
-  std::map<long, detection::Boxes> out;
-  for (const io::TextRow& r : io::readTextTable(path)) {
-    if (r.fields.size() < 7) io::throwAtLine(path, r.line, "expected 'stamp id class x1 y1 x2 y2 ...'");
-    if (r.fields[2] != "person") continue;
-    float c[4];
-    for (int k = 0; k < 4; ++k) c[k] = static_cast<float>(io::parseFiniteDouble(r.fields[3 + k], path, r.line, "corner"));
-    detection::Box b;
-    b.label = "person";
-    b.score = 1.f;
-    b.rect = cv::Rect2f(c[0], c[1], c[2] - c[0], c[3] - c[1]);
-    out[stampKey(io::parseFiniteDouble(r.fields[0], path, r.line, "stamp"))].push_back(b);
-  }
-  return out;
 }
 
 cv::Mat loadGtMask(const io::TumSequence& seq, size_t i) {

@@ -10,9 +10,12 @@
 #include "yolo_slam/io/tum_sequence.h"
 #include "yolo_slam/slam/system.h"
 
+#include "gt_boxes.h"
+
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <string>
 
 using namespace yolo_slam;
@@ -23,6 +26,7 @@ int main(int argc, char** argv) {
     long max_frames = -1;
     int n_features = 0;
     std::vector<std::string> overrides;
+    bool boxes_from_gt = false;
     for (int i = 1; i < argc; ++i) {
       std::string s = argv[i];
       auto val = [&]() -> std::string {
@@ -35,11 +39,12 @@ int main(int argc, char** argv) {
       else if (s == "--features") n_features = std::atoi(val().c_str());
       else if (s == "--dynamic-mode") mode = val();
       else if (s == "--set") overrides.push_back(val());
+      else if (s == "--boxes-from-gt") boxes_from_gt = true;
       else throw Error("unknown option '" + s + "'");
     }
     if (seq_dir.empty() || config.empty())
       throw Error("usage: slam_bench --sequence DIR --config YAML [--max-frames N] [--features N] [--dynamic-mode M] "
-                  "[--set KEY=VALUE ...]");
+                  "[--set KEY=VALUE ...] [--boxes-from-gt]");
     Config cfg = Config::fromFile(config);
     for (const auto& o : overrides) cfg.setFromAssignment(o);
     CameraModel cam = CameraModel::load(cfg);
@@ -49,6 +54,9 @@ int main(int argc, char** argv) {
     io::TumSequence seq = io::TumSequence::open(seq_dir);
     size_t n = seq.size();
     if (max_frames > 0) n = std::min(n, static_cast<size_t>(max_frames));
+    // Person boxes from a synthetic sequence's ground truth (no detector time in the frame).
+    const std::map<long, detection::Boxes> gt_boxes =
+        boxes_from_gt ? bench::readPersonBoxes(seq_dir + "/boxes.txt") : std::map<long, detection::Boxes>{};
     slam::System sys(cam, opt, nullptr);
     std::vector<double> wall, cpu;
     for (size_t i = 0; i < n; ++i) {
@@ -56,7 +64,8 @@ int main(int argc, char** argv) {
       cv::Mat depth = seq.loadDepth(i, cam.depth_map_factor);
       Stopwatch sw;
       const double c0 = threadCpuMs();
-      sys.trackRgbd(bgr, depth, seq.frames()[i].rgb_stamp, {});
+      const auto b = gt_boxes.find(bench::stampKey(seq.frames()[i].rgb_stamp));
+      sys.trackRgbd(bgr, depth, seq.frames()[i].rgb_stamp, b == gt_boxes.end() ? detection::Boxes{} : b->second);
       cpu.push_back(threadCpuMs() - c0);
       wall.push_back(sw.ms());
     }

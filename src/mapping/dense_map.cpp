@@ -29,6 +29,7 @@ const OptionTable<DenseMapOptions>& denseFields() {
       {"DenseMap.probMiss", &O::prob_miss, Range::open(0, 0.5)},
       {"DenseMap.queueSize", &O::queue_size, Range::atLeast(1)},
       {"DenseMap.finalRebuild", &O::final_rebuild},
+      {"DenseMap.maskPeople", &O::mask_people},
   };
   return table;
 }
@@ -182,15 +183,63 @@ void DenseMap::syncInner() const {
   scans_since_inner_ = 0;
 }
 
-std::vector<Voxel> DenseMap::occupiedLeaves() const {
-  syncInner();
+namespace {
+std::vector<Voxel> leavesOf(const octomap::OcTree& tree, bool occupied) {
   std::vector<Voxel> out;
-  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (!tree_->isNodeOccupied(*it)) continue;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (tree.isNodeOccupied(*it) != occupied) continue;
     const octomap::point3d c = it.getCoordinate();
     out.push_back({Eigen::Vector3d(c.x(), c.y(), c.z()), it.getSize()});
   }
   return out;
+}
+}  // namespace
+
+std::vector<Voxel> DenseMap::occupiedLeaves() const {
+  syncInner();
+  return leavesOf(*tree_, true);
+}
+
+std::vector<Voxel> DenseMap::freeLeaves() const {
+  syncInner();
+  return leavesOf(*tree_, false);
+}
+
+OccupancyGrid2D projectToGrid(const std::vector<Voxel>& occupied, const std::vector<Voxel>& free,
+                              double z_min, double z_max, double resolution) {
+  OccupancyGrid2D g;
+  g.resolution = resolution;
+  auto inBand = [&](const Voxel& v) { return v.centre.z() >= z_min && v.centre.z() <= z_max; };
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(Range::kInf), hi = -lo;
+  for (const auto* set : {&occupied, &free})
+    for (const Voxel& v : *set) {
+      if (!inBand(v)) continue;
+      lo = lo.cwiseMin(v.centre.head<2>() - Eigen::Vector2d::Constant(v.size / 2));
+      hi = hi.cwiseMax(v.centre.head<2>() + Eigen::Vector2d::Constant(v.size / 2));
+    }
+  if (!(lo.x() <= hi.x())) return g;
+  g.origin_x = lo.x();
+  g.origin_y = lo.y();
+  g.width = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / resolution)));
+  g.height = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution)));
+  g.cells.assign(static_cast<size_t>(g.width) * g.height, OccupancyGrid2D::kUnknown);
+  // Free first, occupied over it: one occupied leaf in the band blocks the cell.
+  auto paint = [&](const std::vector<Voxel>& set, int8_t value) {
+    for (const Voxel& v : set) {
+      if (!inBand(v)) continue;
+      const int x0 = static_cast<int>(std::floor((v.centre.x() - v.size / 2 - g.origin_x) / resolution + 1e-9));
+      const int y0 = static_cast<int>(std::floor((v.centre.y() - v.size / 2 - g.origin_y) / resolution + 1e-9));
+      const int n = std::max(1, static_cast<int>(std::lround(v.size / resolution)));
+      for (int y = std::max(0, y0); y < std::min(g.height, y0 + n); ++y)
+        for (int x = std::max(0, x0); x < std::min(g.width, x0 + n); ++x) {
+          int8_t& c = g.cells[static_cast<size_t>(y) * g.width + x];
+          if (c != OccupancyGrid2D::kOccupied) c = value;
+        }
+    }
+  };
+  paint(free, OccupancyGrid2D::kFree);
+  paint(occupied, OccupancyGrid2D::kOccupied);
+  return g;
 }
 
 size_t DenseMap::occupiedVoxels() const {

@@ -136,7 +136,8 @@ void DenseMapper::processOne(DenseKeyFrame& kf) {
   Stopwatch sw;
   auto cloud = std::make_shared<KeyFrameCloud>();
   try {
-    const cv::Mat mask = staticMask(kf.depth_m, kf.boxes, screener_, opt_.mask);
+    const cv::Mat mask = opt_.mask_people ? staticMask(kf.depth_m, kf.boxes, screener_, opt_.mask)
+                                          : cv::Mat(kf.depth_m.size(), CV_8UC1, cv::Scalar(255));
     const double mask_ms = sw.ms();
     *cloud = backProject(cam_, opt_, kf.image, kf.depth_m, mask);
     const std::optional<Pose> T_wc = kf.pose ? kf.pose() : std::nullopt;
@@ -219,6 +220,11 @@ DenseMapStats DenseMapper::stats() const {
 std::vector<Voxel> DenseMapper::occupiedLeaves() const {
   std::lock_guard<std::mutex> lk(map_mutex_);
   return map_.occupiedLeaves();
+}
+
+std::vector<Voxel> DenseMapper::freeLeaves() const {
+  std::lock_guard<std::mutex> lk(map_mutex_);
+  return map_.freeLeaves();
 }
 
 std::vector<ColouredPoint> DenseMapper::cloud() const {

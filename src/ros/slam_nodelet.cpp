@@ -25,6 +25,7 @@
 #include <memory>
 #include <mutex>
 
+#include "dense_map_publisher.h"
 #include "nodelet_common.h"
 #include "pose_output.h"
 #include "yolo_slam/KeypointFrame.h"
@@ -59,6 +60,7 @@ class SlamNodelet : public nodelet::Nodelet {
   ~SlamNodelet() override {
     map_timer_.stop();
     diag_timer_.stop();
+    dense_timer_.stop();
     std::lock_guard<std::mutex> lock(system_mutex_);
     if (!system_) return;
     if (!trajectory_path_.empty()) {
@@ -71,6 +73,7 @@ class SlamNodelet : public nodelet::Nodelet {
       }
     }
     system_->shutdown();
+    saveOctomapAtShutdown();
   }
 
  private:
@@ -86,11 +89,18 @@ class SlamNodelet : public nodelet::Nodelet {
     pending_map_ = map_file_;
     pnh.param("map_publish_period", map_period_, 1.0);
     pnh.param("debug_image", debug_image_, true);
+    pnh.param("dense_map", dense_map_, false);
+    pnh.param("dense_map_publish_period", dense_period_, 2.0);
+    pnh.param<std::string>("octomap_path", octomap_path_, "");
+    DenseMapTopicsOptions dense_topics;
+    pnh.param("grid_min_height", dense_topics.grid_min_height, DenseMapTopicsOptions::kDefaultGridMinHeight);
+    pnh.param("grid_max_height", dense_topics.grid_max_height, DenseMapTopicsOptions::kDefaultGridMaxHeight);
     std::string settings_path, voc_path;
     pnh.param<std::string>("vocabulary", voc_path, "");
     try {
       pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
       settings_ = loadSettings(pnh, &settings_path);
+      if (dense_map_) settings_.set("DenseMap.enabled", "1");
       camera_.configure(baseCamera(settings_), use_camera_info_);
       if (!voc_path.empty()) {
         Stopwatch sw;
@@ -113,8 +123,16 @@ class SlamNodelet : public nodelet::Nodelet {
     diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
-    if (debug_image_)
+    if (debug_image_ || dense_map_)
       rgb_sub_ = nh.subscribe("camera/rgb/image_color", 30, &SlamNodelet::onRgb, this);
+    if (dense_map_) {
+      depth_sub_ = nh.subscribe("camera/depth/image", 30, &SlamNodelet::onDepth, this);
+      dense_pub_.advertise(nh, dense_topics);
+      save_octomap_srv_ = nh.advertiseService("yolo_slam/save_octomap", &SlamNodelet::onSaveOctomap, this);
+      if (dense_period_ > 0)
+        dense_timer_ = nh.createWallTimer(::ros::WallDuration(dense_period_),
+                                          [this](const ::ros::WallTimerEvent&) { publishDenseMap(); });
+    }
     frame_sub_ = nh.subscribe("yolo_slam/keypoint_frame", queue_size, &SlamNodelet::onFrame, this,
                               ::ros::TransportHints().tcpNoDelay());
     reset_srv_ = nh.advertiseService("yolo_slam/reset", &SlamNodelet::onReset, this);
@@ -142,7 +160,43 @@ class SlamNodelet : public nodelet::Nodelet {
   void onRgb(const sensor_msgs::ImageConstPtr& img) {
     std::lock_guard<std::mutex> lock(rgb_mutex_);
     recent_rgb_.push_back(img);
-    while (recent_rgb_.size() > 60) recent_rgb_.pop_front();
+    while (recent_rgb_.size() > kRecentImages) recent_rgb_.pop_front();
+  }
+
+  void onDepth(const sensor_msgs::ImageConstPtr& img) {
+    std::lock_guard<std::mutex> lock(rgb_mutex_);
+    recent_depth_.push_back(img);
+    while (recent_depth_.size() > kRecentImages) recent_depth_.pop_front();
+  }
+
+  // The newest of `images` with this stamp (null if gone). Caller holds rgb_mutex_.
+  static sensor_msgs::ImageConstPtr findByStamp(const std::deque<sensor_msgs::ImageConstPtr>& images,
+                                                const ::ros::Time& stamp) {
+    for (auto it = images.rbegin(); it != images.rend(); ++it)
+      if ((*it)->header.stamp == stamp) return *it;
+    return nullptr;
+  }
+
+  // A new keyframe's colour, depth and boxes to the dense map. Caller holds system_mutex_,
+  // right after the trackFeatures that made the keyframe. A missing image skips the keyframe.
+  void handDenseKeyFrame(const KeypointFrame& msg, const slam::TrackResult& res) {
+    sensor_msgs::ImageConstPtr rgb, depth;
+    {
+      std::lock_guard<std::mutex> lock(rgb_mutex_);
+      rgb = findByStamp(recent_rgb_, msg.header.stamp);
+      depth = findByStamp(recent_depth_, msg.depth_stamp);
+    }
+    try {
+      if (!depth) throw Error("its depth image is no longer buffered");
+      const cv::Mat bgr = rgb ? imageToBgr(*rgb, rgb_sub_.getTopic()) : cv::Mat();
+      cv::Mat image;
+      if (!bgr.empty() && camera().rgb_order) cv::cvtColor(bgr, image, cv::COLOR_BGR2RGB);
+      else image = bgr;
+      system_->addDenseKeyFrame(res, image, depthToMetres(*depth, depth_sub_.getTopic()), boxesFromMsg(msg.boxes));
+    } catch (const std::exception& e) {
+      NODELET_WARN_THROTTLE(5.0, "Slam: keyframe at %.3f left out of the dense map: %s", msg.header.stamp.toSec(),
+                            e.what());
+    }
   }
 
   CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
@@ -177,6 +231,7 @@ class SlamNodelet : public nodelet::Nodelet {
       res = system_->trackFeatures(frame);
       corrections = system_->mapCorrections();
       track_ms_.push_back(sw.ms());
+      if (dense_map_ && res.keyframe_inserted) handDenseKeyFrame(*msg, res);
       if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
@@ -343,6 +398,12 @@ class SlamNodelet : public nodelet::Nodelet {
     markers->markers.push_back(kf);
     markers->markers.push_back(edges);
     marker_pub_.publish(markers);
+  }
+
+  void publishDenseMap() {
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    const mapping::DenseMapper* dense = system_ ? system_->denseMap() : nullptr;
+    if (dense) dense_pub_.publish(*dense, pose_out_->worldInMap(), pose_out_->mapFrame(), ::ros::Time::now());
   }
 
   void publishDiagnostics() {
@@ -517,6 +578,40 @@ class SlamNodelet : public nodelet::Nodelet {
     return true;
   }
 
+  // yolo_slam/save_octomap (yolo_slam/MapFile: path, empty = ~octomap_path): the dense map as an
+  // OctoMap .bt in the SLAM world frame; keyframes = keyframes integrated, map_points = voxels.
+  bool onSaveOctomap(yolo_slam::MapFile::Request& req, yolo_slam::MapFile::Response& res) {
+    const std::string path = req.path.empty() ? octomap_path_ : req.path;
+    try {
+      if (path.empty()) throw Error("no path in the request and no ~octomap_path parameter");
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      const mapping::DenseMapper* dense = system_ ? system_->denseMap() : nullptr;
+      if (!dense) throw Error("no dense map yet: the first frame has not arrived");
+      dense->writeOctomap(path);
+      const mapping::DenseMapStats st = dense->stats();
+      res.success = true;
+      res.message = path;
+      res.keyframes = static_cast<uint32_t>(st.keyframes);
+      res.map_points = static_cast<uint32_t>(st.voxels);
+      NODELET_INFO("Slam: octomap saved to %s (%zu voxels)", path.c_str(), st.voxels);
+    } catch (const std::exception& e) {
+      fail(res, "save_octomap failed", e);
+    }
+    return true;
+  }
+
+  // ~octomap_path after the System's shutdown (the final poses). Caller holds system_mutex_.
+  void saveOctomapAtShutdown() {
+    const mapping::DenseMapper* dense = system_->denseMap();
+    if (!dense || octomap_path_.empty()) return;
+    try {
+      dense->writeOctomap(octomap_path_);
+      ROS_INFO("Slam: wrote the dense map to %s at shutdown", octomap_path_.c_str());
+    } catch (const std::exception& e) {
+      ROS_ERROR("Slam: cannot write the dense map at shutdown: %s", e.what());
+    }
+  }
+
   bool onLocalization(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
     std::lock_guard<std::mutex> lock(system_mutex_);
     localization_only_ = req.data;
@@ -530,9 +625,9 @@ class SlamNodelet : public nodelet::Nodelet {
   // Parameters (const after onInit).
   bool use_camera_info_ = true;
   ErrorThrottle throttle_;
-  bool debug_image_ = true;
-  double map_period_ = 1.0;
-  std::string trajectory_path_, map_file_;
+  bool debug_image_ = true, dense_map_ = false;
+  double map_period_ = 1.0, dense_period_ = 2.0;
+  std::string trajectory_path_, map_file_, octomap_path_;
   Config settings_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
@@ -549,8 +644,11 @@ class SlamNodelet : public nodelet::Nodelet {
   std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
   nav_msgs::Path path_;
 
-  std::mutex rgb_mutex_;  // guards recent_rgb_ (colour callback vs frame callback)
-  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_;
+  // Guards recent_rgb_ and recent_depth_ (image callbacks vs frame callback); taken alone or
+  // after system_mutex_.
+  static constexpr size_t kRecentImages = 60;
+  std::mutex rgb_mutex_;
+  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_, recent_depth_;
 
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
@@ -561,14 +659,15 @@ class SlamNodelet : public nodelet::Nodelet {
   std::vector<double> latency_ms_;
   std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
 
-  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;
+  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_, depth_sub_;
   // Pose, odometry and tf. Used by the frame callback; the map timer reads its frames and
   // mount only once system_ exists, i.e. after the frame callback resolved the mount (the
   // mount is written once, before system_ is created under system_mutex_).
   std::unique_ptr<PoseOutput> pose_out_;
   ::ros::Publisher path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
-  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_;
-  ::ros::WallTimer map_timer_, diag_timer_;
+  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_, save_octomap_srv_;
+  ::ros::WallTimer map_timer_, diag_timer_, dense_timer_;
+  DenseMapPublisher dense_pub_;
 };
 
 }  // namespace ros1

@@ -270,3 +270,17 @@ TEST(DenseMapFiles, BadFilesAndInputsNameTheProblem) {
   o.resolution_m = 0;
   EXPECT_THROW(DenseMap(cam, o), Error);
 }
+
+TEST(OccupancyGrid, TheHeightBandDecidesWhatBlocksACell) {
+  const double r = 0.1;
+  const std::vector<Voxel> occupied = {{{0.05, 0.05, 0.5}, r}, {{0.35, 0.05, 2.5}, r}};  // a wall; a lamp above the band
+  const std::vector<Voxel> free = {{{0.2, 0.2, 0.4}, 0.4}};                                 // a pruned free leaf
+  const OccupancyGrid2D g = projectToGrid(occupied, free, 0.1, 1.5, r);
+  ASSERT_EQ(g.width, 4);
+  ASSERT_EQ(g.height, 4);
+  EXPECT_NEAR(g.origin_x, 0.0, 1e-9);
+  EXPECT_EQ(g.cells[0], OccupancyGrid2D::kOccupied);
+  EXPECT_EQ(g.cells[3], OccupancyGrid2D::kFree) << "the lamp is above the band";
+  EXPECT_EQ(g.cells[5], OccupancyGrid2D::kFree);
+  EXPECT_TRUE(projectToGrid(occupied, free, 3.0, 4.0, r).cells.empty());
+}

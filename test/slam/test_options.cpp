@@ -140,6 +140,7 @@ DenseMap.probHit: 0.75
 DenseMap.probMiss: 0.375
 DenseMap.queueSize: 5
 DenseMap.finalRebuild: 0
+DenseMap.maskPeople: 0
 DenseMap.maskMargin: 9
 DenseMap.maskSampleStride: 2
 )";
@@ -203,9 +204,9 @@ TEST(Options, EveryFieldHoldsItsValue) {
   const mapping::DenseMapOptions& dm = sys.dense;
   EXPECT_EQ(std::tie(dm.enabled, dm.resolution_m, dm.max_range_m, dm.pixel_stride, dm.cloud_resolution_m),
             std::make_tuple(true, 0.125, 3.5, 3, 0.03125));
-  EXPECT_EQ(std::tie(dm.prob_hit, dm.prob_miss, dm.queue_size, dm.final_rebuild, dm.mask.margin_px,
+  EXPECT_EQ(std::tie(dm.prob_hit, dm.prob_miss, dm.queue_size, dm.final_rebuild, dm.mask_people, dm.mask.margin_px,
                      dm.mask.sample_stride_px),
-            std::make_tuple(0.75, 0.375, 5, false, 9, 2));
+            std::make_tuple(0.75, 0.375, 5, false, false, 9, 2));
 
   const detection::DetectorOptions d = detection::DetectorOptions::load(cfg);
   EXPECT_EQ(d.model, "/tmp/ys_model");

@@ -51,6 +51,8 @@ struct DenseMapOptions {
                                                      // when full the oldest waiting is dropped
   bool final_rebuild = true;                         // DenseMap.finalRebuild: at the end, all
                                                      // keyframes again with their final poses
+  bool mask_people = true;                           // DenseMap.maskPeople: 0 integrates every
+                                                     // pixel (a plain fusion, for comparison)
   StaticMaskOptions mask;                            // DenseMap.maskMargin, maskSampleStride
 
   // Reads the DenseMap.* keys; invalid values throw yolo_slam::Error naming the file and key.
@@ -84,6 +86,22 @@ struct Voxel {
   double size = 0;
 };
 
+// A 2D occupancy grid from the octree's leaves in a height band (nav_msgs/OccupancyGrid's
+// convention: row-major from the origin, -1 unknown, 0 free, 100 occupied). A cell is occupied
+// when an occupied leaf in the band covers it, free when only free leaves do.
+struct OccupancyGrid2D {
+  static constexpr int8_t kUnknown = -1, kFree = 0, kOccupied = 100;
+  double resolution = 0;
+  double origin_x = 0, origin_y = 0;  // metres, corner of cell (0, 0)
+  int width = 0, height = 0;
+  std::vector<int8_t> cells;
+};
+
+// Projects leaves (centres already in the frame whose z is up, e.g. the ROS map frame) with
+// z_min <= z <= z_max onto the x-y plane at `resolution`; empty grid when none is in the band.
+OccupancyGrid2D projectToGrid(const std::vector<Voxel>& occupied, const std::vector<Voxel>& free,
+                              double z_min, double z_max, double resolution);
+
 class DenseMap {
  public:
   DenseMap(const CameraModel& cam, const DenseMapOptions& options);  // validates the options
@@ -97,6 +115,7 @@ class DenseMap {
   void clear();
 
   std::vector<Voxel> occupiedLeaves() const;
+  std::vector<Voxel> freeLeaves() const;
   // Occupied voxels at the finest resolution (pruned leaves expanded).
   size_t occupiedVoxels() const;
   // One point per cloud voxel (mean position and colour) whose octree voxel is occupied.

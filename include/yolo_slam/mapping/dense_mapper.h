@@ -82,9 +82,11 @@ class DenseMapper {
   // Forgets every keyframe and empties the map (SLAM map reset or replaced).
   void clear();
 
+  const DenseMapOptions& options() const { return opt_; }
   DenseMapStats stats() const;
   // Copies taken under the map lock.
   std::vector<Voxel> occupiedLeaves() const;
+  std::vector<Voxel> freeLeaves() const;
   std::vector<ColouredPoint> cloud() const;
   std::vector<Eigen::Vector3d> occupiedCentres() const;
   void writeOctomap(const std::string& path) const;
