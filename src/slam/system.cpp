@@ -154,22 +154,24 @@ mapping::PoseGetter keyFramePose(const KeyFramePtr& kf, Map& map) {
 
 void System::addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
                               const detection::Boxes& boxes) {
-  if (!dense_ || !res.keyframe_inserted || depth_m.empty()) return;
-  KeyFramePtr kf;
-  {
-    std::lock_guard<std::mutex> tl(track_mutex_);
-    std::lock_guard<std::mutex> ml(map_->update_mutex);
-    kf = tracker_->lastKeyFrame();
+  if (!dense_) return;
+  if (res.keyframe_inserted && !depth_m.empty()) {
+    mapping::DenseKeyFrame d;
+    {
+      std::lock_guard<std::mutex> tl(track_mutex_);
+      std::lock_guard<std::mutex> ml(map_->update_mutex);
+      const KeyFramePtr& kf = tracker_->lastKeyFrame();
+      if (!kf) return;
+      d.id = kf->id;
+      d.stamp = kf->f.stamp;
+      d.pose = keyFramePose(kf, *map_);
+    }
+    d.image = image.clone();
+    d.depth_m = depth_m.clone();
+    d.boxes = boxes;
+    dense_->insert(std::move(d));
   }
-  if (!kf) return;
-  mapping::DenseKeyFrame d;
-  d.id = kf->id;
-  d.stamp = kf->f.stamp;
-  d.pose = keyFramePose(kf, *map_);
-  d.image = image.clone();
-  d.depth_m = depth_m.clone();
-  d.boxes = boxes;
-  dense_->insert(std::move(d));
+  // Sequential: also after frames without a keyframe, so a loop's rebuild is not put off.
   if (run_mode_ == RunMode::Sequential) dense_->processQueued();
 }
 

@@ -119,8 +119,9 @@ class System {
   // Dense map (DenseMap.enabled): hands the keyframe the last trackFeatures made, with the
   // frame's colour image, depth (CV_32F metres) and person boxes, to the dense mapper (copies
   // them; the mapper masks and integrates in its own thread, or here when sequential). Call
-  // right after the trackFeatures whose result it gets; trackRgbd does. No-op unless
-  // res.keyframe_inserted and the dense map is on.
+  // right after the trackFeatures whose result it gets; trackRgbd does. Hands nothing over
+  // unless res.keyframe_inserted and the dense map is on; when sequential, it integrates here
+  // (and rebuilds after a loop) on every call.
   void addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
                         const detection::Boxes& boxes);
   // The dense mapper, null when DenseMap.enabled is 0. Complete (final poses) after shutdown().
