@@ -83,13 +83,10 @@ void DenseMapper::run() {
       kf = std::move(queue_.front());
       queue_.pop_front();
     }
-    busy_ = true;
     lk.unlock();
     if (have) processOne(kf);
     if (versionMoved()) rebuild();
     lk.lock();
-    busy_ = false;
-    cv_.notify_all();
   }
 }
 
@@ -105,12 +102,6 @@ void DenseMapper::processQueued() {
     processOne(kf);
   }
   if (versionMoved()) rebuild();
-}
-
-void DenseMapper::waitIdle() {
-  std::unique_lock<std::mutex> lk(queue_mutex_);
-  if (!running_) return;
-  cv_.wait(lk, [this] { return (queue_.empty() && !busy_) || !running_; });
 }
 
 void DenseMapper::clear() {

@@ -77,8 +77,6 @@ class DenseMapper {
   void insert(DenseKeyFrame kf);
   // Without a thread: integrates the queue (and a rebuild the version asks for) in the caller.
   void processQueued();
-  // Blocks until the queue is empty and nothing is being integrated (no thread: at once).
-  void waitIdle();
   // Forgets every keyframe and empties the map (SLAM map reset or replaced).
   void clear();
 
@@ -116,10 +114,9 @@ class DenseMapper {
 
   // Lock order: queue_mutex_ and map_mutex_ are never held together, and neither while a
   // PoseGetter runs (it takes the SLAM map's mutex).
-  mutable std::mutex queue_mutex_;  // guards queue_, busy_, stop_, running_, finished_, dropped_
+  mutable std::mutex queue_mutex_;  // guards queue_, stop_, running_, finished_, dropped_
   std::condition_variable cv_;
   std::deque<DenseKeyFrame> queue_;
-  bool busy_ = false;
   bool stop_ = false;
   bool running_ = false;
   bool finished_ = false;  // stop() done
