@@ -14,6 +14,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <opencv2/imgcodecs.hpp>
@@ -50,6 +51,8 @@ geometry_msgs::Point g_odom_last;
 // Ground truth relayed into the map frame (scripts/ground_truth_relay.py) and the SLAM path's
 // last pose, to compare without alignment: both start at the first base pose.
 size_t g_gt_len = 0;
+// Dense map topics (~dense_map): points / cubes / grid cells in the last message of each.
+size_t g_dense_occupied = 0, g_dense_markers = 0, g_dense_cloud = 0, g_grid_cells = 0, g_grid_occupied = 0;
 geometry_msgs::Point g_gt_last, g_path_last;
 ros::Time g_gt_last_stamp, g_path_last_stamp;
 std::map<std::string, std::map<std::string, std::string>> g_diag;  // status name -> key -> value
@@ -157,6 +160,28 @@ TEST(FullGraph, SyntheticWalkingBag) {
           g_gt_last = m->poses.back().pose.position;
           g_gt_last_stamp = m->poses.back().header.stamp;
         }
+      });
+  ros::Subscriber dense_occ_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/yolo_slam/octomap_occupied", 10, +[](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_dense_occupied = static_cast<size_t>(m->width) * m->height;
+      });
+  ros::Subscriber dense_cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/yolo_slam/dense_cloud", 10, +[](const sensor_msgs::PointCloud2::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_dense_cloud = static_cast<size_t>(m->width) * m->height;
+      });
+  ros::Subscriber dense_marker_sub = nh.subscribe<visualization_msgs::MarkerArray>(
+      "/yolo_slam/octomap_markers", 10, +[](const visualization_msgs::MarkerArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_dense_markers = 0;
+        for (const auto& mk : m->markers) g_dense_markers += mk.points.size();
+      });
+  ros::Subscriber grid_sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+      "/yolo_slam/grid_map", 10, +[](const nav_msgs::OccupancyGrid::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_grid_cells = m->data.size();
+        g_grid_occupied = static_cast<size_t>(std::count(m->data.begin(), m->data.end(), 100));
       });
   ros::Subscriber path_sub = nh.subscribe<nav_msgs::Path>(
       "/yolo_slam/path", 10, +[](const nav_msgs::Path::ConstPtr& m) {
@@ -324,6 +349,32 @@ TEST(FullGraph, SyntheticWalkingBag) {
               ate.stats.rmse, ate.stats.count, ate_bound, srv.request.path.c_str());
   EXPECT_LT(ate.stats.rmse, ate_bound);
   EXPECT_GE(static_cast<long>(ate.stats.count), tracked - 2);
+
+  bool dense = false;
+  pnh.param("dense_map", dense, false);
+  // Before the map services below: loading a map clears the dense map with the old one.
+  if (dense) {
+    ros::WallDuration(3.0).sleep();  // one dense publication period after the last keyframe
+    {
+      std::lock_guard<std::mutex> lock(g_mutex);
+      std::printf("[full_graph] dense map: %zu occupied voxels, %zu cubes, %zu cloud points, grid %zu cells (%zu "
+                  "occupied)\n",
+                  g_dense_occupied, g_dense_markers, g_dense_cloud, g_grid_cells, g_grid_occupied);
+      EXPECT_GT(g_dense_occupied, 100u);
+      EXPECT_GT(g_dense_markers, 100u);
+      EXPECT_GT(g_dense_cloud, 100u);
+      EXPECT_GT(g_grid_cells, 0u);
+      EXPECT_GT(g_grid_occupied, 0u);
+    }
+    yolo_slam::MapFile octo;
+    octo.request.path = dir + "/dense.bt";
+    ASSERT_TRUE(ros::service::call("/yolo_slam/save_octomap", octo));
+    ASSERT_TRUE(octo.response.success) << octo.response.message;
+    std::ifstream bt(octo.request.path, std::ios::binary);
+    std::string head;
+    std::getline(bt, head);
+    EXPECT_NE(head.find("# Octomap OcTree binary file"), std::string::npos) << octo.request.path << ": " << head;
+  }
 
   // The map through the services: saved, loaded again, and a bad file refused with the
   // running map kept.
