@@ -83,8 +83,8 @@ AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double m
   if (matches.size() < 2) {
     throw Error("ATE: only " + std::to_string(matches.size()) +
                 " ground-truth/estimate timestamp pairs within " + std::to_string(max_diff) +
-                " s (need >= 2); are these files of the same sequence? (raise --max-diff if the "
-                "clocks differ slightly)");
+                " s (need >= 2); are these files of the same sequence? (if the clocks differ "
+                "slightly: yolo_slam_eval ate --max-diff SECONDS)");
   }
   AteResult r;
   std::vector<Eigen::Vector3d> est_pos;

@@ -80,6 +80,25 @@ void load(Ar& ar, Counted<T>& c) {
   }
 }
 
+// A bool member as the byte cereal writes for it, read back only as 0 or 1 (another byte value
+// in a bool is undefined behaviour).
+struct Flag {
+  bool& b;
+};
+
+template <class Ar>
+void save(Ar& ar, const Flag& f) {
+  ar(static_cast<uint8_t>(f.b ? 1 : 0));
+}
+
+template <class Ar>
+void load(Ar& ar, Flag& f) {
+  uint8_t v = 0;
+  ar(v);
+  if (v > 1) throw cereal::Exception("a flag byte is " + std::to_string(v) + ", neither 0 nor 1");
+  f.b = v == 1;
+}
+
 // ---- file records: plain values, fixed-width types, one cereal serialize() each ----
 
 struct Header {
@@ -128,7 +147,7 @@ struct KeyFrameRecord {
   void serialize(Ar& ar) {
     ar(id, frame_id, stamp, T_cw, T_cp, counted(keypoints), counted(descriptors), counted(depth), counted(right_u),
        counted(dynamic), counted(motion));
-    ar(counted(connections), parent, counted(loop_edges), first_connection, not_erase, is_origin);
+    ar(counted(connections), parent, counted(loop_edges), Flag{first_connection}, Flag{not_erase}, Flag{is_origin});
   }
 };
 
@@ -145,7 +164,7 @@ struct MapPointRecord {
   void serialize(Ar& ar) {
     ar(id, Xw, normal, min_dist, max_dist, counted(descriptor), counted(observations), ref_kf, first_kf_id,
        first_frame_id);
-    ar(visible, found, dynamic);
+    ar(visible, found, Flag{dynamic});
   }
 };
 

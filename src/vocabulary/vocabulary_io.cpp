@@ -305,8 +305,10 @@ std::shared_ptr<Vocabulary> Vocabulary::load(const std::string& path) {
 std::shared_ptr<Vocabulary> Vocabulary::loadText(const std::string& path) {
   std::vector<uint8_t> buf = readWholeFile(path);
   checkLooksLikeText(buf, path);
+  const size_t text_bytes = buf.size();
+  buf.push_back('\0');  // strtol/strtod stop here at the latest when the last line has no newline
   const char* p = reinterpret_cast<const char*>(buf.data());
-  const char* end = p + buf.size();
+  const char* end = p + text_bytes;
   size_t line_no = 0;
   int k = 0, levels = 0;
   Weighting weighting = Weighting::TfIdf;
