@@ -7,7 +7,7 @@
 # Environment: JOBS (make -j, default 2), CTEST_ARGS (extra ctest arguments, e.g. "-R vocabulary"),
 # SANITIZE_BUILD_DIR (reuse another build folder configured for the same sanitizer),
 # YS_FUZZ_ITERATIONS (address only: after the suite, the fuzz tests (ctest -R fuzz) run again with
-# this many mutants per target, default 3000; 0 skips that run).
+# this many mutants per target, default 10000; 0 skips that run).
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -54,7 +54,7 @@ if [ "$kind" = thread ]; then
 fi
 
 cd "$build" || exit 1
-fuzz_iterations="${YS_FUZZ_ITERATIONS:-3000}"
+fuzz_iterations="${YS_FUZZ_ITERATIONS:-10000}"
 unset YS_FUZZ_ITERATIONS  # the suite runs the fuzz tests at their default size
 
 # Fails (exit 1) if a sanitizer report is in ctest's last log; $1 names the run.
