@@ -5,7 +5,9 @@
 # tool it ran as a child process).
 #   scripts/sanitize.sh [address|thread]     (default: address = ASan + UBSan; thread = TSan)
 # Environment: JOBS (make -j, default 2), CTEST_ARGS (extra ctest arguments, e.g. "-R vocabulary"),
-# SANITIZE_BUILD_DIR (reuse another build folder configured for the same sanitizer).
+# SANITIZE_BUILD_DIR (reuse another build folder configured for the same sanitizer),
+# YS_FUZZ_ITERATIONS (address only: after the suite, the fuzz tests (ctest -R fuzz) run again with
+# this many mutants per target, default 10000; 0 skips that run).
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -52,19 +54,27 @@ if [ "$kind" = thread ]; then
 fi
 
 cd "$build" || exit 1
+fuzz_iterations="${YS_FUZZ_ITERATIONS:-10000}"
+unset YS_FUZZ_ITERATIONS  # the suite runs the fuzz tests at their default size
+
+# Fails (exit 1) if a sanitizer report is in ctest's last log; $1 names the run.
+check_reports() {
+  local pattern='WARNING: ThreadSanitizer|ERROR: AddressSanitizer|ERROR: LeakSanitizer|runtime error:'
+  local reports
+  reports=$(grep -cE "$pattern" "$build/Testing/Temporary/LastTest.log" 2>/dev/null)
+  reports=${reports:-0}
+  if [ "$reports" -gt 0 ]; then
+    grep -E "$pattern|SUMMARY: " "$build/Testing/Temporary/LastTest.log" | sort | uniq -c | sort -rn | head -20
+    echo "sanitize.sh: FAILED: $reports sanitizer report(s) in $1 (full text in $build/Testing/Temporary/LastTest.log)"
+    exit 1
+  fi
+}
+
 # One test at a time: the SLAM tests start threads of their own and the sanitizers are slow.
 # shellcheck disable=SC2086
 nice -n 10 ctest --output-on-failure --timeout 1800 ${CTEST_ARGS:-} 2>&1 | tee "$log"
 status=${PIPESTATUS[0]}
-
-pattern='WARNING: ThreadSanitizer|ERROR: AddressSanitizer|ERROR: LeakSanitizer|runtime error:'
-reports=$(grep -cE "$pattern" "$build/Testing/Temporary/LastTest.log" 2>/dev/null)
-reports=${reports:-0}
-if [ "$reports" -gt 0 ]; then
-  grep -E "$pattern|SUMMARY: " "$build/Testing/Temporary/LastTest.log" | sort | uniq -c | sort -rn | head -20
-  echo "sanitize.sh: FAILED: $reports sanitizer report(s) (full text in $build/Testing/Temporary/LastTest.log)"
-  exit 1
-fi
+check_reports "the test suite"
 if [ $status -ne 0 ]; then
   echo "sanitize.sh: FAILED: ctest exit $status (see $log)"
   exit 1
@@ -73,4 +83,18 @@ if ! grep -qE "tests passed, 0 tests failed out of [1-9]" "$log"; then
   echo "sanitize.sh: FAILED: no tests ran (see $log)"
   exit 1
 fi
-echo "sanitize.sh: $kind sanitizer clean ($(grep -E 'tests passed' "$log"))"
+summary=$(grep -E 'tests passed' "$log")
+
+# The readers of user files, fuzzed longer under ASan/UBSan (bounded: a fixed number of mutants).
+if [ "$kind" = address ] && [ "$fuzz_iterations" -gt 0 ]; then
+  fuzz_log="$build/fuzz.log"
+  YS_FUZZ_ITERATIONS="$fuzz_iterations" nice -n 10 ctest --output-on-failure --timeout 3600 -R fuzz 2>&1 | tee "$fuzz_log"
+  fuzz_status=${PIPESTATUS[0]}
+  check_reports "the fuzz run"
+  if [ $fuzz_status -ne 0 ] || ! grep -qE "tests passed, 0 tests failed out of [1-9]" "$fuzz_log"; then
+    echo "sanitize.sh: FAILED: fuzz run with $fuzz_iterations mutants per target (see $fuzz_log)"
+    exit 1
+  fi
+  summary="$summary; fuzz tests with $fuzz_iterations mutants per target clean"
+fi
+echo "sanitize.sh: $kind sanitizer clean ($summary)"

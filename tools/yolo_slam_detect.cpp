@@ -61,9 +61,6 @@ struct DetectArgs {
   std::vector<std::string> images;
 };
 
-// OpenCV's thread pool is sized once per process; beyond this it only costs memory.
-constexpr int kMaxThreads = 64;
-
 std::vector<std::string> splitCommas(const std::string& v) {
   std::vector<std::string> out;
   size_t start = 0;
@@ -105,6 +102,7 @@ bool parseOption(const std::string& a, const std::function<std::string()>& value
     opt.nms_threshold = parseFloat(a, value());
   } else if (a == "--threads") {
     const float t = parseFloat(a, value());
+    constexpr int kMaxThreads = detection::DetectorOptions::kMaxThreads;
     if (!(t >= 1 && t <= kMaxThreads)) throw Error("--threads must be in [1, " + std::to_string(kMaxThreads) + "]");
     opt.threads = int(t);
   } else if (a == "--no-letterbox") {

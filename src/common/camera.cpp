@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 
 #include <opencv2/calib3d.hpp>
 
@@ -9,33 +10,36 @@
 
 namespace yolo_slam {
 
+namespace {
+
+// A required key, checked against its rule.
+double requireChecked(const Config& cfg, const std::string& key, const Range& r) {
+  const double v = cfg.requireDouble(key);
+  checkOption(configName(cfg), key, v, r);
+  return v;
+}
+
+}  // namespace
+
 CameraModel CameraModel::load(const Config& cfg) {
   CameraModel c;
-  c.fx = cfg.requireDouble("Camera.fx");
-  c.fy = cfg.requireDouble("Camera.fy");
-  c.cx = cfg.requireDouble("Camera.cx");
-  c.cy = cfg.requireDouble("Camera.cy");
-  c.k1 = cfg.getDouble("Camera.k1", 0.0);
-  c.k2 = cfg.getDouble("Camera.k2", 0.0);
-  c.p1 = cfg.getDouble("Camera.p1", 0.0);
-  c.p2 = cfg.getDouble("Camera.p2", 0.0);
-  c.k3 = cfg.getDouble("Camera.k3", 0.0);
-  c.width = cfg.getInt("Camera.width", c.width);
-  c.height = cfg.getInt("Camera.height", c.height);
-  c.fps = cfg.getDouble("Camera.fps", c.fps);
-  c.bf = cfg.getDouble("Camera.bf", c.bf);
-  c.th_depth = cfg.getDouble("ThDepth", c.th_depth);
-  c.depth_map_factor = cfg.getDouble("DepthMapFactor", c.depth_map_factor);
+  c.width = readInt(cfg, "Camera.width", c.width, Range::closed(1, kMaxImageSide));
+  c.height = readInt(cfg, "Camera.height", c.height, Range::closed(1, kMaxImageSide));
+  c.fx = requireChecked(cfg, "Camera.fx", Range::positive());
+  c.fy = requireChecked(cfg, "Camera.fy", Range::positive());
+  // The principal point lies in the image; outside it the calibration belongs to another size.
+  c.cx = requireChecked(cfg, "Camera.cx", Range::closed(0, c.width));
+  c.cy = requireChecked(cfg, "Camera.cy", Range::closed(0, c.height));
+  for (const auto& [key, v] : {std::make_pair("Camera.k1", &c.k1), std::make_pair("Camera.k2", &c.k2),
+                               std::make_pair("Camera.p1", &c.p1), std::make_pair("Camera.p2", &c.p2),
+                               std::make_pair("Camera.k3", &c.k3)})
+    *v = readDouble(cfg, key, 0.0, Range::any());
+  c.fps = readPositive(cfg, "Camera.fps", c.fps);
+  c.bf = readPositive(cfg, "Camera.bf", c.bf);
+  c.th_depth = readPositive(cfg, "ThDepth", c.th_depth);
+  c.depth_map_factor = readPositive(cfg, "DepthMapFactor", c.depth_map_factor);
+  c.max_depth = readPositive(cfg, "DepthMaxRange", c.max_depth);
   c.rgb_order = cfg.getInt("Camera.RGB", 1) != 0;
-  auto bad = [&](const char* key, const char* why) {
-    throw Error(cfg.path() + ": key '" + key + "' " + why);
-  };
-  if (!(c.fx > 0) || !std::isfinite(c.fx)) bad("Camera.fx", "must be a positive number");
-  if (!(c.fy > 0) || !std::isfinite(c.fy)) bad("Camera.fy", "must be a positive number");
-  if (c.width <= 0 || c.height <= 0) bad("Camera.width", "and Camera.height must be positive");
-  if (!(c.bf > 0)) bad("Camera.bf", "must be positive (baseline in metres times fx)");
-  if (!(c.depth_map_factor > 0)) bad("DepthMapFactor", "must be positive (5000 for TUM PNG, 1 for metres)");
-  if (!(c.fps > 0)) bad("Camera.fps", "must be positive");
   return c;
 }
 

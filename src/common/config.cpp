@@ -1,13 +1,34 @@
 #include "yolo_slam/common/config.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/paths.h"
+#include "yolo_slam/common/settings_keys.h"
 
 #include <opencv2/core.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <regex>
+#include <sstream>
 
 namespace yolo_slam {
 
 namespace {
+
+// OpenCV reports a parse error as "<name>(<line>): <what>" in cv::Exception::func (and the
+// parser's own function name in err): the line and the reason, for a message that points there.
+std::string parseErrorMessage(const cv::Exception& e, const std::string& name) {
+  static const std::regex kAt(R"(\((\d+)\): (.*)$)");
+  std::smatch m;
+  if (std::regex_search(e.func, m, kAt))
+    return name + ":" + m[1].str() + ": malformed YAML (" + m[2].str() + "); fix line " + m[1].str() +
+           " (each setting is 'Key: value', lists are [a, b]) or restore the file from config/";
+  return name + ": malformed or truncated YAML (" + e.err + " " + e.func +
+         "); restore the file from config/ or compare it with config/TUM3.yaml";
+}
 
 std::shared_ptr<cv::FileStorage> openStorage(const std::string& source, bool memory,
                                              const std::string& name) {
@@ -19,10 +40,36 @@ std::shared_ptr<cv::FileStorage> openStorage(const std::string& source, bool mem
       throw Error(name + ": cannot parse as YAML; check the file is complete and starts with %YAML:1.0");
     }
   } catch (const cv::Exception& e) {
-    throw Error(name + ": malformed or truncated YAML (" + e.err +
-                "); restore the file from config/ or fix the line reported");
+    throw Error(parseErrorMessage(e, name));
   }
   return fs;
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The 1-based line on which `key` is set in `text`, 0 if not found.
+size_t lineOfKey(const std::string& text, const std::string& key) {
+  std::istringstream in(text);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++n;
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line.compare(first, key.size(), key) != 0) continue;
+    const size_t colon = line.find_first_not_of(" \t", first + key.size());
+    if (colon != std::string::npos && line[colon] == ':') return n;
+  }
+  return 0;
+}
+
+// "unknown key 'X' is ignored; did you mean 'Y'?"
+std::string unknownKeyMessage(const std::string& key) {
+  return "unknown key '" + key + "' is ignored; did you mean '" + nearestSettingsKey(key) +
+         "'? (every key: config/TUM3.yaml)";
 }
 
 }  // namespace
@@ -34,6 +81,7 @@ Config Config::fromFile(const std::string& path) {
   Config c;
   c.path_ = path;
   c.fs_ = openStorage(path, false, path);
+  c.checkKeys(readText(path));
   return c;
 }
 
@@ -43,7 +91,24 @@ Config Config::fromString(const std::string& yaml, const std::string& name) {
   std::string text = yaml;
   if (text.rfind("%YAML", 0) != 0) text = "%YAML:1.0\n" + text;
   c.fs_ = openStorage(text, true, name);
+  c.checkKeys(text);
   return c;
+}
+
+void Config::checkKeys(const std::string& text) {
+  const cv::FileNode root = fs_->root();
+  if (!root.isMap()) return;
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    const std::string key = (*it).name();
+    if (isKnownSettingsKey(key)) continue;
+    const size_t line = lineOfKey(text, key);
+    warn(path_ + (line ? ":" + std::to_string(line) : std::string()) + ": " + unknownKeyMessage(key));
+  }
+}
+
+void Config::warn(const std::string& message) {
+  std::fprintf(stderr, "warning: %s\n", message.c_str());
+  warnings_.push_back(message);
 }
 
 cv::FileNode Config::node(const std::string& key) const {
@@ -58,6 +123,7 @@ void Config::set(const std::string& key, const std::string& value) {
   const std::string name = "override " + key + "=" + value;
   override_fs_[key] = openStorage("%YAML:1.0\nv: " + value + "\n", true, name);
   override_text_[key] = value;
+  if (!isKnownSettingsKey(key)) warn(name + ": " + unknownKeyMessage(key));
 }
 
 void Config::setFromAssignment(const std::string& assignment) {
@@ -106,7 +172,10 @@ int Config::getInt(const std::string& key, int def) const {
     v = static_cast<int>(n);
   } else if (n.isReal()) {
     const double d = static_cast<double>(n);
-    if (d != static_cast<double>(static_cast<int>(d))) fail(key, "must be an integer");
+    if (!std::isfinite(d) || d != std::floor(d)) fail(key, "must be an integer (got " + formatNumber(d) + ")");
+    if (d < std::numeric_limits<int>::min() || d > std::numeric_limits<int>::max())
+      fail(key, "is out of range (got " + formatNumber(d) + "; an integer of at most " +
+                    std::to_string(std::numeric_limits<int>::max()) + ")");
     v = static_cast<int>(d);
   } else if (!n.empty() && !n.isNone()) {
     fail(key, "must be an integer");

@@ -38,7 +38,7 @@ const OptionTable<DetectorOptions>& detectorFields() {
       {"Detector.letterbox", &O::letterbox},
       {"Detector.confThreshold", &O::conf_threshold, Range::open(0, 1)},
       {"Detector.nmsThreshold", &O::nms_threshold, Range::openClosed(0, 1)},
-      {"Detector.threads", &O::threads, Range::atLeast(1)},
+      {"Detector.threads", &O::threads, Range::closed(1, O::kMaxThreads)},
   };
   return table;
 }

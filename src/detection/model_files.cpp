@@ -291,7 +291,8 @@ void checkDarknetWeights(const std::string& cfg_path, const std::string& weights
   if (size != want)
     throw Error("Darknet weights " + weights_path + " has " + std::to_string(size) +
                 " bytes but " + cfg_path + " needs " + std::to_string(want) + " (" +
-                (size < want ? "truncated" : "weights of a different network") +
+                (size < want ? "truncated, or the weights of a smaller network"
+                             : "weights of a different network") +
                 "); re-download the weights or use the cfg they were trained with");
 }
 

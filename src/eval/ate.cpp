@@ -6,6 +6,8 @@
 #include <Eigen/SVD>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 namespace yolo_slam {
 namespace eval {
@@ -50,10 +52,28 @@ Trajectory uniqueByStamp(const Trajectory& traj) {
   return out;
 }
 
+namespace {
+
+// Refuses a trajectory with a position no camera reaches (see kMaxCoordinateM).
+void checkCoordinates(const Trajectory& traj, const char* which) {
+  for (const StampedPose& p : traj) {
+    const Eigen::Vector3d t = p.T_wc.translation();
+    if (t.allFinite() && t.cwiseAbs().maxCoeff() <= kMaxCoordinateM) continue;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "ATE: the %s pose at stamp %.6f is at (%.3g, %.3g, %.3g) m, beyond %.0e m", which,
+                  p.stamp, t.x(), t.y(), t.z(), kMaxCoordinateM);
+    throw Error(std::string(buf) + ": the file is corrupt or not in metres; fix or remove that line");
+  }
+}
+
+}  // namespace
+
 AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double max_diff,
                      double offset, const Pose* fixed_alignment) {
   if (gt_in.empty()) throw Error("ATE: the ground-truth trajectory has no poses");
   if (est_in.empty()) throw Error("ATE: the estimated trajectory has no poses");
+  checkCoordinates(gt_in, "ground-truth");
+  checkCoordinates(est_in, "estimated");
   const Trajectory gt = uniqueByStamp(gt_in);
   const Trajectory est = uniqueByStamp(est_in);
   std::vector<double> ta, tb;
@@ -63,8 +83,8 @@ AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double m
   if (matches.size() < 2) {
     throw Error("ATE: only " + std::to_string(matches.size()) +
                 " ground-truth/estimate timestamp pairs within " + std::to_string(max_diff) +
-                " s (need >= 2); are these files of the same sequence? (raise --max-diff if the "
-                "clocks differ slightly)");
+                " s (need >= 2); are these files of the same sequence? (if the clocks differ "
+                "slightly: yolo_slam_eval ate --max-diff SECONDS)");
   }
   AteResult r;
   std::vector<Eigen::Vector3d> est_pos;
@@ -80,6 +100,9 @@ AteResult computeAte(const Trajectory& gt_in, const Trajectory& est_in, double m
     r.errors.push_back((r.est_aligned[k] - r.gt_positions[k]).norm());
   }
   r.stats = errorStats(r.errors);
+  // Bounded coordinates keep this finite; a failed alignment would not.
+  if (!r.alignment.matrix().allFinite() || !std::isfinite(r.stats.rmse))
+    throw Error("ATE: the alignment of the estimate onto the ground truth failed (not finite); check both files");
   return r;
 }
 

@@ -19,6 +19,12 @@ const cv::Scalar kWhite(255, 255, 255), kBlack(0, 0, 0), kGrid(225, 225, 225),
     kErr(30, 30, 210);
 const int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
+// Pixel coordinates are clamped this far outside the figure: cv::line clips what it is given,
+// and a point this far out already draws as an edge-to-edge line.
+constexpr double kMaxPixelReach = 1e5;
+
+int clampedPixel(double v) { return static_cast<int>(std::lround(std::clamp(v, -kMaxPixelReach, kMaxPixelReach))); }
+
 // A "nice" step (1, 2 or 5 x 10^k) giving about `ticks` intervals over `range`.
 double niceStep(double range, int ticks) {
   double raw = range / ticks;
@@ -59,10 +65,22 @@ void polyline(cv::Mat& img, const std::vector<cv::Point>& pts, const cv::Scalar&
   if (pts.size() >= 2) cv::polylines(img, pts, false, c, thickness, cv::LINE_AA);
 }
 
+// The grids step through the extents: only finite, bounded values give a finite number of steps.
+void checkPlottable(const Trajectory& gt, const Trajectory& est, const AteResult& ate) {
+  bool ok = std::isfinite(ate.stats.max) && ate.alignment.matrix().allFinite();
+  for (const auto* traj : {&gt, &est})
+    for (const StampedPose& p : *traj)
+      ok = ok && std::isfinite(p.stamp) && p.T_wc.translation().allFinite() &&
+           p.T_wc.translation().cwiseAbs().maxCoeff() <= kMaxCoordinateM;
+  if (!ok)
+    throw Error("ATE plot: a position or the error is not finite or beyond 1e9 m; the trajectories cannot be drawn");
+}
+
 }  // namespace
 
 cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const AteResult& ate,
                       const std::string& title) {
+  checkPlottable(gt_in, est_in, ate);
   const int W = 1000, H = 1120;
   cv::Mat img(H, W, CV_8UC3, kWhite);
   const Trajectory gt = uniqueByStamp(gt_in);
@@ -94,8 +112,8 @@ cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const A
   const double scale = 0.86 * std::min(view.width / ex, view.height / ey);  // pixels per metre
   const double cxm = 0.5 * (lo[ax] + hi[ax]), cym = 0.5 * (lo[ay] + hi[ay]);
   auto toPx = [&](const Eigen::Vector3d& p) {
-    return cv::Point(static_cast<int>(std::lround(view.x + view.width / 2 + (p[ax] - cxm) * scale)),
-                     static_cast<int>(std::lround(view.y + view.height / 2 - (p[ay] - cym) * scale)));
+    return cv::Point(clampedPixel(view.x + view.width / 2 + (p[ax] - cxm) * scale),
+                     clampedPixel(view.y + view.height / 2 - (p[ay] - cym) * scale));
   };
   // Metre grid and tick labels.
   const double span_x = view.width / scale, span_y = view.height / scale;
@@ -161,8 +179,8 @@ cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const A
   const double emax = std::max(ate.stats.max * 1.1, 1e-4);
   const double tstep = niceStep(tr, 10), estep = niceStep(emax, 4);
   auto errPx = [&](double t, double e) {
-    return cv::Point(static_cast<int>(std::lround(panel.x + (t - t0) / tr * panel.width)),
-                     static_cast<int>(std::lround(panel.y + panel.height - e / emax * panel.height)));
+    return cv::Point(clampedPixel(panel.x + (t - t0) / tr * panel.width),
+                     clampedPixel(panel.y + panel.height - e / emax * panel.height));
   };
   for (double g = 0; g <= tr + 1e-9; g += tstep) {
     cv::Point p = errPx(t0 + g, 0);

@@ -25,7 +25,7 @@ namespace {
 const OptionTable<OrbOptions>& orbFields() {
   using O = OrbOptions;
   static const OptionTable<O> table = {
-      {"ORBextractor.nFeatures", &O::n_features, Range::atLeast(1)},
+      {"ORBextractor.nFeatures", &O::n_features, Range::atLeast(O::kMinFeatures)},
       {"ORBextractor.scaleFactor", &O::scale_factor, Range::openClosed(1, 4)},
       {"ORBextractor.nLevels", &O::n_levels, Range::closed(1, 32)},
       {"ORBextractor.iniThFAST", &O::ini_th_fast, Range::closed(1, 254)},

@@ -22,14 +22,14 @@ constexpr double kBoostStep = 0.25;
 constexpr double kBoostBelowKept = 0.75;
 
 // The depth as screening and tracking read it: a cleaned CV_32F copy (invalid readings 0).
-cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp) {
+cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp, double max_depth) {
   if (depth_m.empty()) return cv::Mat();
   if (depth_m.type() != CV_32FC1 || depth_m.size() != image.size())
     throw Error("frame " + std::to_string(stamp) + ": depth image " + std::to_string(depth_m.cols) + "x" +
                 std::to_string(depth_m.rows) + " of type " + cv::typeToString(depth_m.type()) +
                 " does not match the " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                 " colour image (need registered CV_32FC1 metres)");
-  return io::decodeDepth(depth_m, 1.0, "frame " + std::to_string(stamp));
+  return io::decodeDepth(depth_m, 1.0, "frame " + std::to_string(stamp), max_depth);
 }
 
 }  // namespace
@@ -78,7 +78,7 @@ FrontEndResult FrontEnd::extractAndScreen(size_t step, const cv::Mat& image, con
 FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
   if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
-  const cv::Mat depth = checkedDepth(depth_m, image, stamp);
+  const cv::Mat depth = checkedDepth(depth_m, image, stamp, cam.max_depth);
   const size_t step = budgetStep();
   FrontEndResult r = extractAndScreen(step, image, depth, stamp, boxes, cam, detector_ran);
   // The first frame of a stream has no last frame to size its budget by, and SLAM initialises

@@ -1,6 +1,7 @@
 #include "yolo_slam/io/tum_sequence.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/io/association.h"
 #include "yolo_slam/io/depth.h"
@@ -8,6 +9,8 @@
 #include "yolo_slam/io/trajectory.h"
 
 #include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
 
 namespace yolo_slam {
 namespace io {
@@ -77,15 +80,26 @@ TumSequence TumSequence::open(const std::string& dir, double max_diff) {
     }
     if (seq.frames_.empty()) {
       throw Error(rgb_txt + ": no rgb stamp has a depth stamp in " + depth_txt + " within " +
-                  std::to_string(max_diff) + " s; check the files or raise the max difference");
+                  formatNumber(max_diff) + " s; the two lists must use the same clock (seconds) "
+                  "and list the same recording: check both files, or write associations.txt "
+                  "('rgb_stamp rgb_file depth_stamp depth_file') to pair the frames yourself");
     }
   }
-  const std::string gt = joinPath(dir, "groundtruth.txt");
-  if (fileExists(gt)) {
-    seq.gt_ = readTrajectory(gt);
-    seq.has_gt_ = true;
-  }
+  seq.readGroundTruth(joinPath(dir, "groundtruth.txt"));
   return seq;
+}
+
+void TumSequence::readGroundTruth(const std::string& path) {
+  if (!fileExists(path)) return;
+  try {
+    gt_ = readTrajectory(path);
+    has_gt_ = true;
+  } catch (const Error& e) {
+    // Ground truth is optional: a bad line costs the ATE, not the run.
+    gt_warning_ = std::string(e.what()) + "; the sequence is run without ground truth (no ATE): fix or "
+                  "remove the line";
+    std::fprintf(stderr, "warning: %s\n", gt_warning_.c_str());
+  }
 }
 
 const Trajectory& TumSequence::groundTruth() const {
@@ -103,6 +117,7 @@ const TumFrame& TumSequence::frame(size_t i) const {
 
 cv::Mat TumSequence::loadRgb(size_t i) const {
   const std::string& path = frame(i).rgb_path;
+  if (dirExists(path)) throw Error(path + ": is a folder, expected an rgb image file; fix its line in rgb.txt or associations.txt");
   if (!fileExists(path)) throw Error(path + ": rgb image not found");
   cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
   if (img.empty()) throw Error(path + ": cannot decode rgb image (corrupt or unsupported format)");

@@ -193,6 +193,26 @@ cv::Mat depthToMetres(const sensor_msgs::Image& msg, const std::string& topic, d
               "; expected 16UC1 (millimetres) or 32FC1 (metres), see REP 118");
 }
 
+namespace {
+
+// A NaN or infinite K or D entry would pass every comparison and poison every projection.
+void checkFiniteCalibration(const sensor_msgs::CameraInfo& info, const std::string& topic) {
+  const auto finite = [](const auto& values) {
+    for (double v : values)
+      if (!std::isfinite(v)) return false;
+    return true;
+  };
+  if (!finite(info.K) || !finite(info.D))
+    throw Error("camera_info on " + topic + " has a NaN or infinite entry in K or D; fix the camera's "
+                "calibration file or set use_camera_info false to use the settings file");
+  if (info.K[2] < 0 || info.K[2] > info.width || info.K[5] < 0 || info.K[5] > info.height)
+    throw Error("camera_info on " + topic + ": principal point (" + std::to_string(info.K[2]) + ", " +
+                std::to_string(info.K[5]) + ") lies outside the " + std::to_string(info.width) + "x" +
+                std::to_string(info.height) + " image; fix the calibration");
+}
+
+}  // namespace
+
 CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraModel& base,
                            const std::string& topic) {
   if (info.width == 0 || info.height == 0 || info.K[0] <= 0 || info.K[4] <= 0)
@@ -200,6 +220,7 @@ CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraMode
                 std::to_string(info.width) + "x" + std::to_string(info.height) + ", fx " +
                 std::to_string(info.K[0]) + "); calibrate the camera or set use_camera_info "
                 "false to use the settings file");
+  checkFiniteCalibration(info, topic);
   CameraModel cam = base;
   // Keep bf as baseline * fx when fx changes, so ThDepth keeps its meaning in metres.
   const double baseline = base.fx > 0 ? base.bf / base.fx : 0.0;

@@ -22,6 +22,7 @@
 
 #include <atomic>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 
@@ -201,6 +202,21 @@ class SlamNodelet : public nodelet::Nodelet {
 
   CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
 
+  // A frame not newer than the last one tracked would be written out of order into the
+  // trajectory: dropped and counted. A bag played again needs yolo_slam/reset.
+  bool inStampOrder(double stamp) {
+    const double last = last_stamp_.load();
+    if (stamp > last) {
+      last_stamp_.store(stamp);
+      return true;
+    }
+    ++out_of_order_;
+    NODELET_WARN_THROTTLE(2.0, "Slam: frame %.6f is not newer than the last one (%.6f): dropped, %zu "
+                          "out-of-order frame(s) so far; call yolo_slam/reset when a bag restarts",
+                          stamp, last, out_of_order_.load());
+    return false;
+  }
+
   void onFrame(const KeypointFrame::ConstPtr& msg) {
     if (last_index_ != 0 && msg->index > last_index_ + 1) {
       const size_t gap = msg->index - last_index_ - 1;
@@ -211,6 +227,7 @@ class SlamNodelet : public nodelet::Nodelet {
     }
     last_index_ = msg->index;
     ++received_;
+    if (!inStampOrder(msg->header.stamp.toSec())) return;
     slam::TrackResult res;
     size_t corrections = 0;
     features::FeatureFrame frame;
@@ -417,7 +434,7 @@ class SlamNodelet : public nodelet::Nodelet {
     }
     const size_t dropped = dropped_, rejected = rejected_;
     const slam::TrackingState state = last_state_;
-    st.level = dropped + rejected > 0 || state == slam::TrackingState::Lost
+    st.level = dropped + rejected + out_of_order_ > 0 || state == slam::TrackingState::Lost
                    ? diagnostic_msgs::DiagnosticStatus::WARN
                    : diagnostic_msgs::DiagnosticStatus::OK;
     st.message = std::string("tracking ") + stateName(state) + ", " + std::to_string(dropped) +
@@ -433,6 +450,7 @@ class SlamNodelet : public nodelet::Nodelet {
     kv("not_tracked", not_tracked_);
     kv("dropped", dropped);
     kv("rejected_bad_input", rejected);
+    kv("out_of_order", out_of_order_);
     diagnostic_msgs::KeyValue m;
     m.key = "track_median_ms";
     m.value = std::to_string(s.median);
@@ -459,6 +477,7 @@ class SlamNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(system_mutex_);
       if (system_) system_->reset();
     }
+    last_stamp_.store(-std::numeric_limits<double>::infinity());
     {
       std::lock_guard<std::mutex> lock(path_mutex_);
       path_.poses.clear();
@@ -653,6 +672,10 @@ class SlamNodelet : public nodelet::Nodelet {
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
   std::atomic<size_t> received_{0}, tracked_{0}, not_tracked_{0}, dropped_{0}, rejected_{0};
+  // Stamp of the last frame let through (frame callback; reset stores -inf), and the frames
+  // dropped for not being newer.
+  std::atomic<double> last_stamp_{-std::numeric_limits<double>::infinity()};
+  std::atomic<size_t> out_of_order_{0};
   // Image stamp to pose, the last kLatencyWindow frames (frame callback vs diagnostics timer).
   static constexpr size_t kLatencyWindow = 2000;
   std::mutex latency_mutex_;  // guards latency_ms_

@@ -16,10 +16,12 @@
 #include <cereal/types/utility.hpp>
 #include <cereal/types/vector.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 #include <unordered_map>
 
 namespace yolo_slam {
@@ -35,6 +37,67 @@ constexpr const char* kRebuildHint = "rebuild the map with yolo_slam_run --save-
 // FNV-1a, 64-bit offset basis and prime.
 constexpr uint64_t kFnvBasis = 1469598103934665603ull;
 constexpr uint64_t kFnvPrime = 1099511628211ull;
+
+// ---- counts bounded by the payload ----
+
+// A count in a file that passed the checksum can still be wrong (a writer bug, a crafted file);
+// cereal would allocate it before reading. Counts are therefore checked against the payload's
+// size (every element takes at least one byte of it). Set by parsePayload while it reads.
+thread_local size_t t_payload_bytes = 0;
+
+// A vector member written as cereal writes it, read with its count checked.
+template <class T>
+struct Counted {
+  std::vector<T>& v;
+};
+template <class T>
+Counted<T> counted(std::vector<T>& v) {
+  return {v};
+}
+
+template <class Ar, class T>
+void save(Ar& ar, const Counted<T>& c) {
+  ar(c.v);
+}
+
+template <class Ar, class T>
+void load(Ar& ar, Counted<T>& c) {
+  cereal::size_type n = 0;
+  ar(cereal::make_size_tag(n));
+  const size_t bytes_each = std::is_arithmetic<T>::value ? sizeof(T) : 1;
+  if (n > t_payload_bytes / bytes_each)
+    throw cereal::Exception("a count of " + std::to_string(n) + " exceeds the payload");
+  c.v.clear();
+  if constexpr (std::is_arithmetic<T>::value) {
+    c.v.resize(static_cast<size_t>(n));
+    ar(cereal::binary_data(c.v.data(), static_cast<size_t>(n) * sizeof(T)));
+  } else {
+    // Grown as elements are read: a count larger than what follows fails at the end of the data.
+    for (cereal::size_type i = 0; i < n; ++i) {
+      c.v.emplace_back();
+      ar(c.v.back());
+    }
+  }
+}
+
+// A bool member as the byte cereal writes for it, read back only as 0 or 1 (another byte value
+// in a bool is undefined behaviour).
+struct Flag {
+  bool& b;
+};
+
+template <class Ar>
+void save(Ar& ar, const Flag& f) {
+  ar(static_cast<uint8_t>(f.b ? 1 : 0));
+}
+
+template <class Ar>
+void load(Ar& ar, Flag& f) {
+  uint8_t v = 0;
+  ar(v);
+  if (v > 1) throw cereal::Exception("a flag byte is " + std::to_string(v) + ", neither 0 nor 1");
+  f.b = v == 1;
+}
 
 // ---- file records: plain values, fixed-width types, one cereal serialize() each ----
 
@@ -82,8 +145,9 @@ struct KeyFrameRecord {
   bool first_connection = true, not_erase = false, is_origin = false;
   template <class Ar>
   void serialize(Ar& ar) {
-    ar(id, frame_id, stamp, T_cw, T_cp, keypoints, descriptors, depth, right_u, dynamic, motion);
-    ar(connections, parent, loop_edges, first_connection, not_erase, is_origin);
+    ar(id, frame_id, stamp, T_cw, T_cp, counted(keypoints), counted(descriptors), counted(depth), counted(right_u),
+       counted(dynamic), counted(motion));
+    ar(counted(connections), parent, counted(loop_edges), Flag{first_connection}, Flag{not_erase}, Flag{is_origin});
   }
 };
 
@@ -98,8 +162,9 @@ struct MapPointRecord {
   bool dynamic = false;
   template <class Ar>
   void serialize(Ar& ar) {
-    ar(id, Xw, normal, min_dist, max_dist, descriptor, observations, ref_kf, first_kf_id, first_frame_id);
-    ar(visible, found, dynamic);
+    ar(id, Xw, normal, min_dist, max_dist, counted(descriptor), counted(observations), ref_kf, first_kf_id,
+       first_frame_id);
+    ar(visible, found, Flag{dynamic});
   }
 };
 
@@ -110,7 +175,7 @@ struct Payload {
   std::vector<KeyFrameRecord> keyframes;
   std::vector<MapPointRecord> points;
   template <class Ar>
-  void serialize(Ar& ar) { ar(camera, vocabulary, next_kf_id, next_point_id, keyframes, points); }
+  void serialize(Ar& ar) { ar(camera, vocabulary, next_kf_id, next_point_id, counted(keyframes), counted(points)); }
 };
 
 // ---- checksums ----
@@ -274,6 +339,7 @@ Payload parsePayload(const std::string& path, const std::string& bytes, size_t o
     throw Error(path + ": map file corrupted (payload checksum mismatch); " + kRebuildHint);
   Payload p;
   std::istringstream is(bytes.substr(offset), std::ios::binary);
+  t_payload_bytes = h.payload_size;
   try {
     cereal::PortableBinaryInputArchive ar(is);
     ar(p);
@@ -330,12 +396,30 @@ void checkIdentity(const std::string& path, const Payload& p, const MapFileConte
   throw Error(path + ": map file corrupted (" + what + "); " + kRebuildHint);
 }
 
+bool finitePose(const PoseRecord& T) {
+  return std::all_of(T.begin(), T.end(), [](double v) { return std::isfinite(v); });
+}
+
+// Values the frame rebuild indexes or divides by: a pyramid level that exists, finite
+// coordinates, depths and poses.
+void checkKeyFrameValues(const std::string& path, const KeyFrameRecord& r, int levels) {
+  const std::string kf = "keyframe " + std::to_string(r.id);
+  if (!finitePose(r.T_cw) || !finitePose(r.T_cp)) corrupt(path, kf + " has a non-finite pose");
+  for (const KeyPointRecord& k : r.keypoints)
+    if (k.octave < 0 || k.octave >= levels || !std::isfinite(k.x) || !std::isfinite(k.y) || !std::isfinite(k.size) ||
+        !std::isfinite(k.angle))
+      corrupt(path, kf + " has a keypoint off the image pyramid");
+  for (size_t i = 0; i < r.depth.size(); ++i)
+    if (!std::isfinite(r.depth[i]) || !std::isfinite(r.right_u[i])) corrupt(path, kf + " has a non-finite depth");
+}
+
 KeyFramePtr makeKeyFrame(const std::string& path, const KeyFrameRecord& r, const CameraModel& cam,
                          const FrameGeometry& geom, const std::shared_ptr<const ScalePyramid>& pyr) {
   const size_t n = r.keypoints.size();
   if (r.descriptors.size() != n * kDescriptorBytes || r.depth.size() != n || r.right_u.size() != n ||
       r.dynamic.size() != n || (!r.motion.empty() && r.motion.size() != n))
     corrupt(path, "keyframe " + std::to_string(r.id) + " has inconsistent keypoint arrays");
+  checkKeyFrameValues(path, r, pyr->n_levels);
   features::FeatureFrame ff;
   ff.stamp = r.stamp;
   for (const KeyPointRecord& k : r.keypoints)
@@ -380,6 +464,9 @@ void linkKeyFrames(const std::string& path, const Payload& p, const KeyFrameInde
 
 MapPointPtr makeMapPoint(const std::string& path, const MapPointRecord& r, const KeyFrameIndex& index) {
   const Eigen::Vector3d Xw(r.Xw[0], r.Xw[1], r.Xw[2]);
+  if (!Xw.allFinite() || !std::isfinite(r.normal[0] + r.normal[1] + r.normal[2]) || !std::isfinite(r.min_dist) ||
+      !std::isfinite(r.max_dist))
+    corrupt(path, "point " + std::to_string(r.id) + " has a non-finite position or scale range");
   auto mp = std::make_shared<MapPoint>(r.id, Xw, nullptr, r.first_frame_id);
   mp->normal = Eigen::Vector3d(r.normal[0], r.normal[1], r.normal[2]);
   mp->min_dist = r.min_dist;

@@ -3,6 +3,7 @@
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/json.h"
+#include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/local_mapping.h"
@@ -20,6 +21,22 @@
 namespace yolo_slam {
 namespace slam {
 
+namespace {
+
+// Initialisation needs Tracking.initMinKeyPoints static keypoints; a budget that cannot give them
+// would lose every frame without a word.
+void checkInitialisable(const SystemOptions& o, const std::string& where) {
+  const double most = o.orb.n_features * o.orb.dynamic_boost_max;
+  if (most < o.slam.tracking.init_min_keypoints)
+    rejectOption(where, "ORBextractor.nFeatures",
+                 ">= Tracking.initMinKeyPoints / ORBextractor.dynamicBoostMax = " +
+                     formatNumber(o.slam.tracking.init_min_keypoints / o.orb.dynamic_boost_max) +
+                     ", or tracking can never initialise (raise nFeatures or lower Tracking.initMinKeyPoints)",
+                 std::to_string(o.orb.n_features));
+}
+
+}  // namespace
+
 SystemOptions SystemOptions::load(const Config& cfg) {
   SystemOptions o;
   o.orb = features::OrbOptions::load(cfg);
@@ -27,6 +44,7 @@ SystemOptions SystemOptions::load(const Config& cfg) {
   o.slam = SlamOptions::load(cfg);
   o.dense = mapping::DenseMapOptions::load(cfg);
   o.sequential = cfg.getBool("System.sequential", o.sequential);
+  checkInitialisable(o, configName(cfg));
   return o;
 }
 
@@ -93,11 +111,29 @@ namespace {
 // System's policy for a depth image that does not fit: warn and track without depth.
 cv::Mat usableDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
   if (depth.empty() || image.empty()) return cv::Mat();
-  if (depth.type() == CV_32FC1 && depth.size() == image.size()) return depth;
-  std::fprintf(stderr, "warning: frame %.6f: depth image %dx%d type %d does not match the %dx%d "
-               "colour image (need CV_32FC1 metres); frame tracked without depth\n",
-               stamp, depth.cols, depth.rows, depth.type(), image.cols, image.rows);
-  return cv::Mat();
+  if (depth.type() != CV_32FC1) {
+    std::fprintf(stderr, "warning: frame %.6f: depth image of type %s, need CV_32FC1 metres (decode it "
+                 "with io::decodeDepth); frame tracked without depth\n", stamp, cv::typeToString(depth.type()).c_str());
+    return cv::Mat();
+  }
+  if (depth.size() != image.size()) {
+    std::fprintf(stderr, "warning: frame %.6f: the depth image is %dx%d, the colour image %dx%d; "
+                 "register the depth to the colour camera at its size; frame tracked without depth\n",
+                 stamp, depth.cols, depth.rows, image.cols, image.rows);
+    return cv::Mat();
+  }
+  return depth;
+}
+
+// An image of another size than the calibration would be tracked with the wrong intrinsics: a
+// plausible but wrong trajectory. Refused loudly instead.
+void checkImageSize(const cv::Mat& image, const CameraModel& cam, double stamp) {
+  if (image.empty() || (image.cols == cam.width && image.rows == cam.height)) return;
+  throw Error("frame " + formatNumber(stamp) + ": the colour image is " + std::to_string(image.cols) + "x" +
+              std::to_string(image.rows) + " but the settings' Camera.width/height are " +
+              std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+              "; use the settings file calibrated for this camera and image size (Camera.width, "
+              "Camera.height, fx, fy, cx, cy)");
 }
 }  // namespace
 
@@ -106,6 +142,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   std::call_once(front_end_once_, [this] {
     front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
   });
+  checkImageSize(image, cam_, stamp);
   frontend::FrontEndResult fe;
   try {
     fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_, detector_ran);

@@ -25,6 +25,8 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -232,6 +234,28 @@ std::shared_ptr<Vocabulary> readBinary(const std::string& path) {
   return v;
 }
 
+// `n` bytes at `p` as a message may quote them: non-printable bytes as '?'.
+std::string quotable(const char* p, size_t n) {
+  std::string out(p, n);
+  for (char& c : out)
+    if (!std::isprint(static_cast<unsigned char>(c))) c = '?';
+  return out;
+}
+
+// A text vocabulary is ASCII digits and spaces; a NUL or another control byte in its first
+// kibibytes means the file is binary data of some other kind.
+void checkLooksLikeText(const std::vector<uint8_t>& buf, const std::string& path) {
+  constexpr size_t kSniffBytes = 4096;
+  const size_t n = std::min(buf.size(), kSniffBytes);
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = buf[i];
+    if (c == '\n' || c == '\r' || c == '\t' || std::isprint(c)) continue;
+    throw Error(path + ": not a vocabulary: neither a yolo_slam binary vocabulary (it would start "
+                "with YSVOCAB) nor an ORB-SLAM2 text vocabulary (byte " + std::to_string(i) +
+                " is binary data); pass a .vocab written by yolo_slam_train_vocab or ORBvoc.txt");
+  }
+}
+
 // Strict number parsing on one text line; reports file:line on any problem.
 struct LineParser {
   const char* cur;
@@ -254,7 +278,7 @@ struct LineParser {
     errno = 0;
     const long v = std::strtol(cur, &stop, 10);
     if (stop == cur || errno != 0 || (stop < end && !std::isspace(static_cast<unsigned char>(*stop))))
-      fail(std::string("bad ") + field + " '" + std::string(cur, std::min<size_t>(end - cur, 16)) + "'");
+      fail(std::string("bad ") + field + " '" + quotable(cur, std::min<size_t>(end - cur, 16)) + "'");
     cur = stop;
     return v;
   }
@@ -264,7 +288,7 @@ struct LineParser {
     char* stop = nullptr;
     const double v = std::strtod(cur, &stop);
     if (stop == cur || (stop < end && !std::isspace(static_cast<unsigned char>(*stop))) || !std::isfinite(v))
-      fail(std::string("bad ") + field + " '" + std::string(cur, std::min<size_t>(end - cur, 16)) + "'");
+      fail(std::string("bad ") + field + " '" + quotable(cur, std::min<size_t>(end - cur, 16)) + "'");
     cur = stop;
     return v;
   }
@@ -280,8 +304,11 @@ std::shared_ptr<Vocabulary> Vocabulary::load(const std::string& path) {
 
 std::shared_ptr<Vocabulary> Vocabulary::loadText(const std::string& path) {
   std::vector<uint8_t> buf = readWholeFile(path);
+  checkLooksLikeText(buf, path);
+  const size_t text_bytes = buf.size();
+  buf.push_back('\0');  // strtol/strtod stop here at the latest when the last line has no newline
   const char* p = reinterpret_cast<const char*>(buf.data());
-  const char* end = p + buf.size();
+  const char* end = p + text_bytes;
   size_t line_no = 0;
   int k = 0, levels = 0;
   Weighting weighting = Weighting::TfIdf;

@@ -6,6 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
+
 using namespace yolo_slam;
 
 TEST(Config, ReadsOrbSlamStyleKeys) {
@@ -90,4 +94,81 @@ TEST(Config, EffectiveRecordsWhatEveryGetterReturned) {
   EXPECT_EQ(e["Name"], "x");
   EXPECT_FALSE(e.contains("Unread.key"));
   EXPECT_EQ(copy.effective(), e);
+}
+
+namespace {
+
+// The message of the yolo_slam::Error `f` throws ("" and a test failure when it throws none).
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a yolo_slam::Error";
+  return "";
+}
+
+const char* kCamera = "Camera.fx: 535.4\nCamera.fy: 539.2\nCamera.cx: 320.1\nCamera.cy: 247.6\n";
+
+}  // namespace
+
+TEST(Config, YamlErrorNamesTheLine) {
+  char path[] = "/tmp/ys_truncated_XXXXXX.yaml";
+  const int fd = ::mkstemps(path, 5);
+  ASSERT_GE(fd, 0);
+  const std::string text = "%YAML:1.0\nCamera.fx: 535.4\nCamera.fy: 539.2\nCamera.cx 320.1\n";
+  ASSERT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(fd);
+  const std::string msg = errorOf([&] { Config::fromFile(path); });
+  std::remove(path);
+  EXPECT_NE(msg.find(std::string(path) + ":4: malformed YAML (Missing ':')"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("fix line 4"), std::string::npos) << msg;
+}
+
+TEST(Config, IntegerOutOfRangeSaysSo) {
+  const Config c = Config::fromString("ORBextractor.nFeatures: 1e10\nORBextractor.nLevels: 2.5\n", "r.yaml");
+  const std::string big = errorOf([&] { c.getInt("ORBextractor.nFeatures", 0); });
+  EXPECT_NE(big.find("r.yaml: key 'ORBextractor.nFeatures' is out of range (got 10000000000"), std::string::npos) << big;
+  const std::string frac = errorOf([&] { c.getInt("ORBextractor.nLevels", 0); });
+  EXPECT_NE(frac.find("must be an integer (got 2.5)"), std::string::npos) << frac;
+}
+
+TEST(Config, UnknownKeysWarnWithTheNearestKnownKey) {
+  const Config c = Config::fromString("Camera.fx: 535.4\nORBextractor.nFeaturez: 1500\nViewer.PointSize: 2\n", "typo.yaml");
+  ASSERT_EQ(c.warnings().size(), 1u) << "Viewer.* of ORB-SLAM2 files is accepted";
+  const std::string& w = c.warnings()[0];
+  // fromString puts "%YAML:1.0" in front: the key is on line 3 of that text.
+  EXPECT_NE(w.find("typo.yaml:3: unknown key 'ORBextractor.nFeaturez' is ignored; did you mean "
+                   "'ORBextractor.nFeatures'?"),
+            std::string::npos)
+      << w;
+  Config o;
+  o.set("screening.Mode", "off");
+  ASSERT_EQ(o.warnings().size(), 1u);
+  EXPECT_NE(o.warnings()[0].find("did you mean 'Screening.mode'"), std::string::npos) << o.warnings()[0];
+  EXPECT_TRUE(Config::fromString(kCamera).warnings().empty());
+}
+
+TEST(Config, ShippedFilesHaveNoUnknownKey) {
+  for (const char* name : {"TUM1.yaml", "TUM2.yaml", "TUM3.yaml"})
+    EXPECT_TRUE(Config::fromFile(joinPath(packageDir(), std::string("config/") + name)).warnings().empty()) << name;
+}
+
+TEST(Config, CameraRejectsNanAndAbsurdValuesNamingFileAndKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"Camera.cx", ".nan"},       {"Camera.cy", "1e9"},       {"Camera.cx", "-3"},
+      {"Camera.fx", ".inf"},       {"Camera.k1", ".nan"},      {"Camera.width", "1e10"},
+      {"Camera.height", "100000"}, {"DepthMaxRange", "0"},     {"Camera.bf", ".nan"},
+      {"ThDepth", "-1"},
+  };
+  for (const auto& [key, value] : cases) {
+    Config c = Config::fromString(kCamera, "cam.yaml");
+    c.set(key, value);
+    const std::string msg = errorOf([&] { CameraModel::load(c); });
+    EXPECT_NE(msg.find(std::string("cam.yaml: key '") + key + "'"), std::string::npos) << key << msg;
+  }
+  const CameraModel cam = CameraModel::load(Config::fromString(std::string(kCamera) + "DepthMaxRange: 6\n"));
+  EXPECT_DOUBLE_EQ(cam.max_depth, 6.0);
 }

@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <unistd.h>
 
@@ -213,4 +214,29 @@ TEST(Ate, FixedAlignmentIsUsedAsGiven) {
   const eval::AteResult off = eval::computeAte(gt, est, 0.02, 0.0, &shifted);
   EXPECT_NEAR(off.stats.rmse, 0.1, 1e-9);
   EXPECT_TRUE(off.alignment.isApprox(shifted, 1e-12));
+}
+
+TEST(Ate, HugeCoordinatesAreRefusedNotReportedAsInfinity) {
+  Trajectory gt, est;
+  for (int i = 0; i < 10; ++i) {
+    StampedPose p;
+    p.stamp = 1.0 + 0.1 * i;
+    p.T_wc = makePose(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1 * i, 0, 1));
+    gt.push_back(p);
+    if (i == 4) p.T_wc.translation().x() = 1e160;
+    est.push_back(p);
+  }
+  try {
+    eval::computeAte(gt, est);
+    FAIL() << "an estimate at 1e160 m must not give an rmse";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the estimated pose at stamp 1.400000"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("beyond 1e+09 m"), std::string::npos) << e.what();
+  }
+  // The plot refuses what it cannot draw instead of stepping through an infinite grid.
+  eval::AteResult bad = eval::computeAte(gt, gt);
+  bad.stats.max = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(eval::renderAtePlot(gt, gt, bad, "t"), Error);
+  EXPECT_THROW(eval::renderAtePlot(gt, est, eval::computeAte(gt, gt), "t"), Error);
+  EXPECT_EQ(eval::renderAtePlot(gt, gt, eval::computeAte(gt, gt), "t").type(), CV_8UC3);
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sys/stat.h>
 #include <unistd.h>
 
 using namespace yolo_slam;
@@ -23,7 +24,7 @@ TEST(Depth, Decodes16BitWithFactor) {
   ASSERT_EQ(d.type(), CV_32FC1);
   EXPECT_FLOAT_EQ(d.at<float>(0, 0), 0.f);
   EXPECT_FLOAT_EQ(d.at<float>(0, 1), 1.f);
-  EXPECT_FLOAT_EQ(d.at<float>(0, 2), 65535.f / 5000.f);
+  EXPECT_EQ(d.at<float>(0, 2), 0.f) << "65535 is the saturated code, not 13.1 m";
   EXPECT_FLOAT_EQ(d.at<float>(1, 0), 1.f / 5000.f);
   EXPECT_FLOAT_EQ(d.at<float>(1, 1), 1.5f);
   EXPECT_FLOAT_EQ(d.at<float>(1, 2), 12345.f / 5000.f);
@@ -72,4 +73,50 @@ TEST(Depth, LoadsPngAndRejectsMissingOrCorrupt) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(p), std::string::npos);
   }
+}
+
+TEST(Depth, CountsReadingsAndRejectsBeyondTheRange) {
+  cv::Mat raw = (cv::Mat_<uint16_t>(1, 5) << 0, 5000, 49999, 50001, io::kInvalidDepthCode);
+  io::DepthCounts n;
+  const cv::Mat d = io::decodeDepth(raw, 5000.0, "r", 10.0, &n);
+  EXPECT_FLOAT_EQ(d.at<float>(0, 1), 1.f);
+  EXPECT_FLOAT_EQ(d.at<float>(0, 2), 9.9998f);
+  EXPECT_EQ(d.at<float>(0, 3), 0.f) << "10.0002 m is beyond the 10 m range";
+  EXPECT_EQ(d.at<float>(0, 4), 0.f);
+  EXPECT_EQ(n.valid, 2u);
+  EXPECT_EQ(n.invalid, 1u);
+  EXPECT_EQ(n.beyond_range, 1u);
+  EXPECT_EQ(n.saturated, 1u);
+  // Float metres obey the same range; a range <= 0 is refused with the name.
+  const cv::Mat f = (cv::Mat_<float>(1, 2) << 4.f, 12.f);
+  const cv::Mat df = io::decodeDepth(f, 1.0, "f", 10.0);
+  EXPECT_FLOAT_EQ(df.at<float>(0, 0), 4.f);
+  EXPECT_EQ(df.at<float>(0, 1), 0.f);
+  try {
+    io::decodeDepth(f, 1.0, "f.exr", 0.0);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("f.exr: DepthMaxRange"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Depth, AllSaturatedOrAFolderIsAnErrorNamingTheFile) {
+  const std::string dir = "/tmp/ys_io_depth_dir_" + std::to_string(::getpid());
+  const std::string p = dir + ".png";
+  ASSERT_TRUE(cv::imwrite(p, cv::Mat(4, 4, CV_16UC1, cv::Scalar(io::kInvalidDepthCode))));
+  try {
+    io::loadDepth(p, 5000.0);
+    ADD_FAILURE() << "an all-65535 image is no depth";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(p + ": every reading is 65535"), std::string::npos) << e.what();
+  }
+  std::remove(p.c_str());
+  ASSERT_EQ(::mkdir(dir.c_str(), 0755), 0);
+  try {
+    io::loadDepth(dir, 5000.0);
+    ADD_FAILURE() << "a folder is not an image";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + ": is a folder"), std::string::npos) << e.what();
+  }
+  ::rmdir(dir.c_str());
 }

@@ -31,13 +31,14 @@ Camera.k2: -0.75
 Camera.p1: -0.0078125
 Camera.p2: 0.001953125
 Camera.k3: 1.125
-Camera.width: 320
-Camera.height: 240
+Camera.width: 800
+Camera.height: 600
 Camera.fps: 15.0
 Camera.bf: 35.5
 Camera.RGB: 0
 ThDepth: 35.0
 DepthMapFactor: 1000.0
+DepthMaxRange: 8.5
 ORBextractor.nFeatures: 1500
 ORBextractor.scaleFactor: 1.25
 ORBextractor.nLevels: 6
@@ -192,8 +193,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(c.fx, c.fy, c.cx, c.cy), std::make_tuple(517.5, 516.25, 318.75, 255.5));
   EXPECT_EQ(std::tie(c.k1, c.k2, c.p1, c.p2, c.k3),
             std::make_tuple(0.25, -0.75, -0.0078125, 0.001953125, 1.125));
-  EXPECT_EQ(std::tie(c.width, c.height, c.fps, c.bf, c.rgb_order, c.th_depth, c.depth_map_factor),
-            std::make_tuple(320, 240, 15.0, 35.5, false, 35.0, 1000.0));
+  EXPECT_EQ(std::tie(c.width, c.height, c.fps, c.bf, c.rgb_order, c.th_depth, c.depth_map_factor, c.max_depth),
+            std::make_tuple(800, 600, 15.0, 35.5, false, 35.0, 1000.0, 8.5));
 
   const slam::SystemOptions sys = slam::SystemOptions::load(cfg);
   const features::OrbOptions& orb = sys.orb;
@@ -348,7 +349,7 @@ TEST(Options, RejectionsNameFileKeyRuleAndValue) {
   EXPECT_EQ(detectorRejection("Detector.confThreshold", "1"),
             "bad.yaml: key 'Detector.confThreshold' must be in (0, 1) (got 1)");
   EXPECT_EQ(detectorRejection("Detector.threads", "0"),
-            "bad.yaml: key 'Detector.threads' must be >= 1 (got 0)");
+            "bad.yaml: key 'Detector.threads' must be in [1, 64] (got 0)");
   EXPECT_EQ(detectorRejection("Detector.inputWidth", "100"),
             "bad.yaml: key 'Detector.inputWidth' must be a multiple of 32 (got 100)");
   EXPECT_EQ(rejection("Detection.maxAge", "-1", [](const Config& c) { detection::AsyncDetectionOptions::load(c); }),

@@ -19,10 +19,17 @@ struct CameraModel {
   double bf = 40.0;
   double th_depth = 40.0;            // ThDepth, in baselines: close if depth < th_depth * bf / fx
   double depth_map_factor = 5000.0;  // DepthMapFactor: raw 16-bit value / factor = metres
+  // DepthMaxRange: readings farther than this (metres) are no reading; 10 m is the Kinect /
+  // OpenNI limit, beyond which structured-light depth is noise.
+  double max_depth = 10.0;
   bool rgb_order = true;             // Camera.RGB: 1 if images are RGB, 0 if BGR
 
-  // Reads Camera.fx/fy/cx/cy/k1/k2/p1/p2/k3/width/height/fps/bf/RGB, ThDepth, DepthMapFactor.
-  // fx, fy, cx, cy are required; others default to the values above.
+  static constexpr int kMaxImageSide = 16384;  // pixels; larger is a typo, not a camera
+
+  // Reads Camera.fx/fy/cx/cy/k1/k2/p1/p2/k3/width/height/fps/bf/RGB, ThDepth, DepthMapFactor,
+  // DepthMaxRange. fx, fy, cx, cy are required; others default to the values above. Throws
+  // yolo_slam::Error naming the file and key for a value that is NaN, infinite or absurd (the
+  // principal point outside the image, a size beyond kMaxImageSide).
   static CameraModel load(const Config& cfg);
 
   bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }

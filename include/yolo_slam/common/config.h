@@ -21,7 +21,9 @@ class Config {
   Config() = default;
 
   // Opens and parses a YAML file. Throws yolo_slam::Error naming the file when it is missing,
-  // unreadable or malformed (for example truncated).
+  // unreadable or malformed (for example truncated; file:line when OpenCV names the line). A key
+  // no loader reads (see common/settings_keys.h) is a warning on stderr naming file:line and the
+  // nearest known key, kept in warnings().
   static Config fromFile(const std::string& path);
   // Parses YAML text (for tests); `name` is used in error messages.
   static Config fromString(const std::string& yaml, const std::string& name = "<string>");
@@ -44,11 +46,13 @@ class Config {
 
   // Overrides `key` with `value`, a YAML scalar or flow list ("0.5", "detect", "[a, b]"),
   // before any options are loaded: the runner's --set and the nodelets' ~overrides. Throws
-  // yolo_slam::Error naming the key when the value is not YAML.
+  // yolo_slam::Error naming the key when the value is not YAML; an unknown key is a warning.
   void set(const std::string& key, const std::string& value);
   // "Key=value" as given on a command line; throws yolo_slam::Error without a '='.
   void setFromAssignment(const std::string& assignment);
   const std::map<std::string, std::string>& overrides() const { return override_text_; }
+  // The warnings given so far (unknown keys), as printed.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   // Every key read so far, with the value the getter returned (a default when the key was
   // absent): the effective options, for stats.json. Shared by copies of this Config.
@@ -58,12 +62,15 @@ class Config {
   cv::FileNode node(const std::string& key) const;
   [[noreturn]] void fail(const std::string& key, const std::string& why) const;
   void record(const std::string& key, Json value) const;
+  void checkKeys(const std::string& text);  // warns about the unknown top-level keys of fs_
+  void warn(const std::string& message);
 
   std::string path_;
   std::shared_ptr<cv::FileStorage> fs_;
   // One parsed document per override ("v: <value>"), looked up before fs_.
   std::map<std::string, std::shared_ptr<cv::FileStorage>> override_fs_;
   std::map<std::string, std::string> override_text_;
+  std::vector<std::string> warnings_;
   struct Record {
     std::mutex mutex;  // guards values (options may load on several threads)
     std::map<std::string, Json> values;

@@ -38,6 +38,9 @@ struct DetectorOptions {
   // cv::setNumThreads before each forward pass. OpenCV's thread count is process-wide: it also
   // applies to other OpenCV calls made meanwhile in other threads.
   int threads = 2;
+  // OpenCV's thread pool is sized once per process; beyond this it only costs memory (and tens of
+  // thousands of threads crash at exit).
+  static constexpr int kMaxThreads = 64;
   // Class names kept, looked up in each model's names file; every model must know one of them
   // ("body" is the only class of yolo-fastest-1.1-body).
   std::vector<std::string> dynamic_classes{"person", "body"};

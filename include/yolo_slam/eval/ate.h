@@ -31,9 +31,14 @@ struct AteResult {
   std::vector<double> errors;       // |gt - aligned est| (m)
 };
 
+// Farther than this from the origin (metres) a position is not a camera trajectory but a corrupt
+// file; its squares would overflow the alignment and the error statistics.
+constexpr double kMaxCoordinateM = 1e9;
+
 // gt and est are deduplicated with uniqueByStamp, associated with io::associate(gt, est,
 // offset, max_diff) as evaluate_ate.py does, and aligned. Throws yolo_slam::Error if either is
-// empty or fewer than 2 pairs are found ("no overlapping timestamps").
+// empty, fewer than 2 pairs are found ("no overlapping timestamps"), a position is beyond
+// kMaxCoordinateM, or the result is not finite: never an "rmse inf".
 // fixed_alignment: use this T_gt_est instead of aligning (a run in a loaded map, evaluated in
 // the frame the mapping run's alignment gives that map).
 AteResult computeAte(const Trajectory& gt, const Trajectory& est, double max_diff = 0.02,

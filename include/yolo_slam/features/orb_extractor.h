@@ -14,7 +14,10 @@ class Config;
 namespace features {
 
 struct OrbOptions {
-  int n_features = 1000;      // ORBextractor.nFeatures: total over all levels
+  // Fewer keypoints cannot hold a pose (ORB-SLAM2 needs 30 inliers after matching and outlier
+  // rejection, a fraction of what is extracted): below this nFeatures is a typo.
+  static constexpr int kMinFeatures = 100;
+  int n_features = 1000;      // ORBextractor.nFeatures: total over all levels, >= kMinFeatures
   double scale_factor = 1.2;  // ORBextractor.scaleFactor: between consecutive levels (> 1)
   int n_levels = 8;           // ORBextractor.nLevels
   int ini_th_fast = 20;       // ORBextractor.iniThFAST: FAST threshold tried first in a cell

@@ -42,9 +42,9 @@ class FrontEnd {
   FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOptions& screening);
 
   // image: BGR/RGB per cam.rgb_order, or gray. depth_m: CV_32F metres registered to the image
-  // (NaN, inf and values <= 0 are invalid), or empty for no depth. Throws yolo_slam::Error
-  // when the image is empty or of an unsupported type, or the depth is of another type or
-  // size than the image. Safe to call from several threads: frames are processed one at a time.
+  // (NaN, inf, values <= 0 and beyond cam.max_depth, DepthMaxRange, are invalid), or empty for
+  // no depth. Throws yolo_slam::Error when the image is empty or of an unsupported type, or the
+  // depth is of another type or size than the image. Safe to call from several threads: frames are processed one at a time.
   // detector_ran false: no detection was made for this frame (asynchronous detection).
   FrontEndResult process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                          const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran = true);

@@ -109,7 +109,8 @@ class System {
   // Extract + screen + track (sequential: then local mapping and loop closing). `image`:
   // BGR/RGB per Camera.RGB or gray; `depth_m`: CV_32F metres (0/NaN invalid) or empty. Bad
   // input (empty image, wrong depth size/type) is reported on stderr and the frame is reported
-  // lost; never throws for per-frame data problems.
+  // lost. A colour image whose size is not Camera.width x Camera.height throws yolo_slam::Error
+  // (the settings belong to another camera: every pose would be wrong).
   // detector_ran false: `boxes` is empty because no detection was made for this frame
   // (asynchronous detection), so the box tracker carries every box.
   TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
