@@ -19,7 +19,10 @@ DEPENDENCIES='
   nav_msgs:           libnav-msgs-dev python3-nav-msgs
   visualization_msgs: libvisualization-msgs-dev python3-visualization-msgs
   diagnostic_msgs:    libdiagnostic-msgs-dev python3-diagnostic-msgs
+  diagnostic_updater: libdiagnostic-updater-dev
   tf2_ros:            libtf2-ros-dev python3-tf2-ros
+  tf2_eigen:          libtf2-eigen-dev
+  cv_bridge:          libcv-bridge-dev
   message_filters:    libmessage-filters-dev
   libopencv-dev:      libopencv-dev
   eigen:              libeigen3-dev
@@ -27,6 +30,7 @@ DEPENDENCIES='
   libopenni2-dev:     libopenni2-dev
   nlohmann-json-dev:  nlohmann-json3-dev
   libcereal-dev:      libcereal-dev
+  liboctomap-dev:     liboctomap-dev octomap-tools
   message_generation: ros-message-generation
   message_runtime:    ros-message-runtime
   roslaunch:          python3-roslaunch rosbash
@@ -39,6 +43,8 @@ DEPENDENCIES='
   rostest:            python3-rostest
   rosgraph_msgs:      libros-rosgraph-msgs-dev
   gtest:              libgtest-dev
+  xvfb:               xvfb
+  imagemagick:        imagemagick
   data:               opencv-doc darknet
 '
 # data: real images and video (textures and people for the simulator, vocabulary training

@@ -2,9 +2,13 @@
 """Writes a TUM-format RGB-D sequence folder into a ROS bag laid out like the official TUM bags.
 
 Topics: /camera/rgb/image_color (sensor_msgs/Image, rgb8), /camera/depth/image (32FC1, metres),
-/camera/rgb/camera_info and /camera/depth/camera_info (sensor_msgs/CameraInfo), /tf
-(tf2_msgs/TFMessage: the ground truth as world -> kinect, then the static kinect ->
-openni_rgb_optical_frame identity, so the optical frame's pose in world is groundtruth.txt).
+/camera/rgb/camera_info and /camera/depth/camera_info (sensor_msgs/CameraInfo), /tf of type
+tf/tfMessage as in the official bags (the same definition and md5 as tf2_msgs/TFMessage): the
+chain /world -> /kinect (motion capture) -> /openni_camera -> /openni_rgb_frame ->
+/openni_rgb_optical_frame (and /openni_camera -> /openni_depth_frame ->
+/openni_depth_optical_frame), with /world -> /kinect chosen so that the colour optical frame's
+pose in /world is groundtruth.txt. Depth is registered to colour: its images carry the colour
+optical frame id.
 
 usage: scripts/tum_to_bag.py SEQUENCE_DIR OUTPUT.bag [--fx 535.4 --fy 539.2 --cx 320.1 --cy 247.6]
        [--depth-factor 5000] [--max-diff 0.02]
@@ -23,6 +27,15 @@ import rospy
 from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
+
+
+class TfMessage(TFMessage):
+    """tf/tfMessage, the type official TUM bags use for /tf (tf2 listeners accept it: same md5)."""
+    _type = "tf/tfMessage"
+
+
+# ROS optical frame (z forward, x right, y down) in its body frame (x forward, z up): x y z w.
+OPTICAL_IN_BODY = (-0.5, 0.5, -0.5, 0.5)
 
 
 class TumError(Exception):
@@ -45,6 +58,41 @@ def read_list(path):
             except (ValueError, IndexError):
                 raise TumError("%s:%d: malformed line %r" % (path, n, line))
     return rows
+
+
+def quat_mul(a, b):
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def quat_inv(q):
+    return (-q[0], -q[1], -q[2], q[3])
+
+
+def transform(stamp, parent, child, xyz=(0.0, 0.0, 0.0), q=(0.0, 0.0, 0.0, 1.0)):
+    t = TransformStamped()
+    t.header.stamp = stamp
+    t.header.frame_id = parent
+    t.child_frame_id = child
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = xyz
+    t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, t.transform.rotation.w = q
+    return t
+
+
+def tf_chain(stamp, pose):
+    """The official bags' tree for one ground-truth pose of the colour optical frame."""
+    xyz, q_opt = pose[:3], pose[3:]
+    q_kinect = quat_mul(q_opt, quat_inv(OPTICAL_IN_BODY))
+    return TfMessage([transform(stamp, "/world", "/kinect", xyz, q_kinect),
+                      transform(stamp, "/kinect", "/openni_camera"),
+                      transform(stamp, "/openni_camera", "/openni_rgb_frame"),
+                      transform(stamp, "/openni_rgb_frame", "/openni_rgb_optical_frame", q=OPTICAL_IN_BODY),
+                      transform(stamp, "/openni_camera", "/openni_depth_frame"),
+                      transform(stamp, "/openni_depth_frame", "/openni_depth_optical_frame", q=OPTICAL_IN_BODY)])
 
 
 def associate(a, b, max_diff):
@@ -124,19 +172,7 @@ def main():
     frame_id = "/openni_rgb_optical_frame"
     with rosbag.Bag(args.bag, "w") as bag:
         for t, v in gt:
-            tf = TransformStamped()
-            tf.header.stamp = stamp_of(t)
-            tf.header.frame_id = "/world"
-            tf.child_frame_id = "/kinect"
-            (tf.transform.translation.x, tf.transform.translation.y, tf.transform.translation.z,
-             tf.transform.rotation.x, tf.transform.rotation.y, tf.transform.rotation.z,
-             tf.transform.rotation.w) = v
-            opt = TransformStamped()
-            opt.header.stamp = stamp_of(t)
-            opt.header.frame_id = "/kinect"
-            opt.child_frame_id = frame_id
-            opt.transform.rotation.w = 1.0
-            bag.write("/tf", TFMessage([tf, opt]), stamp_of(t))
+            bag.write("/tf", tf_chain(stamp_of(t), v), stamp_of(t))
         for tr, td in pairs:
             rp, dp = os.path.join(seq, rgb[tr]), os.path.join(seq, depth[td])
             im = cv2.imread(rp, cv2.IMREAD_COLOR)

@@ -1,7 +1,9 @@
 // yolo_slam_run: the offline runner (ORB-SLAM2's rgbd_tum equivalent). Reads a TUM RGB-D
 // folder, runs detection (own thread, one frame ahead), screening and SLAM frame by frame and
 // writes CameraTrajectory.txt, KeyFrameTrajectory.txt and stats.json; optionally starts in a map
-// loaded from a file and saves the map at the end (slam/map_file.h).
+// loaded from a file and saves the map at the end (slam/map_file.h). Every output is checked
+// before the first frame, the tracking poses are appended to CameraTrajectory.partial.txt as
+// they are estimated, and stats.json, written last, says whether the run is complete.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -14,6 +16,8 @@
 #include "yolo_slam/eval/ate.h"
 #include "yolo_slam/io/atomic_file.h"
 #include "yolo_slam/io/camera_feed.h"
+#include "yolo_slam/io/playback.h"
+#include "yolo_slam/io/run_output.h"
 #include "yolo_slam/io/text_table.h"
 #include "yolo_slam/io/trajectory.h"
 #include "yolo_slam/io/tum_sequence.h"
@@ -23,6 +27,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -34,32 +41,73 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <sys/stat.h>
 #include <thread>
 
 using namespace yolo_slam;
 
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-// First Ctrl-C: finish the frame and write the results; the handler then reverts to the default
-// so a second Ctrl-C quits at once (signal() is async-signal-safe).
-void onSignal(int sig) {
-  g_stop = 1;
-  std::signal(sig, SIG_DFL);
+// Written by the signal handler only, read by the frame loop and the waits. Lock-free atomics:
+// the handler may run in any thread, several at once when signals arrive together.
+std::atomic<int> g_stop{0};     // number of the first stop signal; 0 while none came
+std::atomic<int> g_signals{0};  // stop signals received
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+// The signal that quits at once without the results. The first stops the run and has the
+// results written; the second is only acknowledged, since an impatient second Ctrl-C 50 ms
+// later, while they are being written, must not lose the whole run.
+constexpr int kForceQuitSignal = 3;
+constexpr int kExitError = 1;
+constexpr int kExitTooFewTracked = 3;
+constexpr int kExitSignalBase = 128;  // 128 + signal number, as a shell reports it
+constexpr double kDefaultMinTracked = 0.1;
+
+// The handler, async-signal-safe: lock-free atomics, write(2) and _exit only.
+void onStopSignal(int sig) {
+  const int n = g_signals.fetch_add(1) + 1;
+  if (n == 1) {
+    g_stop = sig;
+    return;
+  }
+  if (n < kForceQuitSignal) {
+    static const char msg[] = "\nyolo_slam_run: stopping and writing the results; one more signal quits without them\n";
+    (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
+    return;
+  }
+  static const char msg[] = "\nyolo_slam_run: quitting at once; the poses so far are in CameraTrajectory.partial.txt\n";
+  (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
+  ::_exit(kExitSignalBase + sig);
 }
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// SIGINT, SIGTERM and SIGHUP (an ssh session dropped) stop the run and write the results;
+// SIGPIPE is ignored, so output to a closed pipe (| head) fails quietly and the run goes on.
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onStopSignal;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : kStopSignals) sigaddset(&sa.sa_mask, sig);
+  sa.sa_flags = SA_RESTART;
+  for (int sig : kStopSignals) ::sigaction(sig, &sa, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+}
+
+bool stopRequested() { return g_stop != 0; }
 
 const char* kVocabName = "vocab/yolo_slam_orb_k10_L4.vocab";
 
 const char* kUsage =
     "usage: yolo_slam_run --sequence DIR --out DIR [--config YAML] [--max-frames N]\n"
-    "                     [--realtime | --camera-rate] [--detection async|every-frame]\n"
+    "                     [--min-tracked F] [--realtime | --camera-rate]\n"
+    "                     [--detection async|every-frame]\n"
     "                     [--dynamic-mode off|detect|geometry|detect+geometry] [--model DIR]\n"
     "                     [--single-model]\n"
     "                     [--vocabulary FILE | --no-vocabulary] [--boxes-from-gt | --boxes FILE]\n"
     "                     [--track-boxes on|off] [--propagate-labels on|off]\n"
     "                     [--static-box-veto on|off] [--sequential] [--set KEY=VALUE ...]\n"
     "                     [--load-map FILE] [--save-map FILE] [--localization]\n"
+    "                     [--octomap OUT.bt] [--cloud OUT.ply]\n"
     "Runs YOLO-SLAM on a TUM RGB-D folder (rgb.txt/depth.txt or associations.txt) and writes\n"
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
@@ -68,15 +116,22 @@ const char* kUsage =
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
     "keypoints on the masks of people (person_recall) and of every moving object\n"
     "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
-    "Ctrl-C (or SIGTERM) stops at the next frame and still writes everything (exit code 130); a\n"
-    "second Ctrl-C quits at once without writing.\n"
+    "While it runs, OUT/CameraTrajectory.partial.txt gets every tracking pose as it is estimated\n"
+    "(kept after a kill or crash) and stats.json says \"complete\": false until the end.\n"
+    "Ctrl-C, SIGTERM or SIGHUP stops at the next frame and still writes everything (exit code\n"
+    "128 + signal: 130 for Ctrl-C); a second one is ignored, a third quits at once without them\n"
+    "(the partial trajectory stays). Exit code 3: fewer frames tracked than --min-tracked\n"
+    "(everything is still written); 1: bad arguments, unreadable input, unwritable output.\n"
     "  --sequence DIR     the TUM RGB-D folder (required)\n"
     "  --out DIR          output folder, created if missing (required)\n"
     "  --config YAML      settings (Camera.*, ORBextractor.*, Screening.*, Tracking.*,\n"
     "                     LocalMapping.*, LoopClosing.*, System.*, Detector.*); default\n"
     "                     DIR/camera.yaml if it exists\n"
     "  --max-frames N     only the first N frames\n"
-    "  --realtime         pace frames at the sequence's timestamps instead of full speed\n"
+    "  --min-tracked F    exit code 3 when fewer than this fraction of the frames got a pose\n"
+    "                     (default 0.1; 0 accepts any run)\n"
+    "  --realtime         pace frames at the sequence's timestamps instead of full speed (a\n"
+    "                     forward stamp gap over 2 s is played as 2 s, with a warning)\n"
     "  --camera-rate      feed frames at the sequence's timestamps as a camera does: a frame\n"
     "                     that arrives while the pipeline is busy replaces the waiting one\n"
     "                     (dropped); stats.json \"camera\" has offered/processed/dropped frames\n"
@@ -117,13 +172,18 @@ const char* kUsage =
     "                     \"map_file\" has its size and the save and load times\n"
     "  --localization     track against the map without adding keyframes or points (with\n"
     "                     --load-map: localisation in a prebuilt map)\n"
+    "  --octomap FILE     --set DenseMap.enabled=1 and write the dense static map (people left\n"
+    "                     out) as an OctoMap .bt file at the end; stats.json \"dense_map\"\n"
+    "  --cloud FILE       the same, and its coloured point cloud as binary PLY\n"
     "  -h, --help         this text\n";
 
 struct Args {
   std::string sequence, config, out, model, vocabulary, boxes_file, load_map, save_map;
+  std::string octomap, cloud;  // dense map outputs (--octomap, --cloud)
   // Settings overrides in command-line order (--set and the flags that stand for a key).
   std::vector<std::string> overrides;
   long max_frames = -1;
+  double min_tracked = kDefaultMinTracked;
   bool realtime = false, camera_rate = false, boxes_from_gt = false, no_vocabulary = false, vocabulary_given = false,
        single_model = false, localization = false;
 };
@@ -147,12 +207,12 @@ long positiveLong(const std::string& flag, const std::string& v) {
   return n;
 }
 
-// --save-map writes at the end of the run: a folder that does not exist should fail now, not
-// after the whole sequence.
-void checkSaveMapFolder(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, std::max<size_t>(slash, 1));
-  if (!dirExists(dir)) throw Error(path + ": --save-map folder " + dir + " does not exist; create it first");
+double fractionArg(const std::string& flag, const std::string& v) {
+  char* end = nullptr;
+  const double f = std::strtod(v.c_str(), &end);
+  if (!end || *end || v.empty() || !(f >= 0 && f <= 1))
+    throw Error(flag + " must be a fraction in [0, 1] (got '" + v + "')");
+  return f;
 }
 
 // Fills in the settings file and the vocabulary the user did not name.
@@ -200,9 +260,12 @@ Args parseArgs(int argc, char** argv) {
     else if (s == "--static-box-veto") a.overrides.push_back(onOffOverride(s, "Screening.staticBoxVeto", need(i, s)));
     else if (s == "--track-boxes") a.overrides.push_back(onOffOverride(s, "Screening.trackBoxes", need(i, s)));
     else if (s == "--max-frames") a.max_frames = positiveLong(s, need(i, s));
+    else if (s == "--min-tracked") a.min_tracked = fractionArg(s, need(i, s));
     else if (s == "--load-map") a.load_map = need(i, s);
     else if (s == "--save-map") a.save_map = need(i, s);
     else if (s == "--localization") a.localization = true;
+    else if (s == "--octomap") a.octomap = need(i, s);
+    else if (s == "--cloud") a.cloud = need(i, s);
     else if (s == "-h" || s == "--help") {
       std::fputs(kUsage, stdout);
       std::exit(0);
@@ -215,7 +278,11 @@ Args parseArgs(int argc, char** argv) {
   if (a.vocabulary_given && a.no_vocabulary) throw Error("--vocabulary and --no-vocabulary exclude each other");
   if (a.boxes_from_gt && !a.boxes_file.empty()) throw Error("--boxes and --boxes-from-gt exclude each other");
   if (a.realtime && a.camera_rate) throw Error("--realtime and --camera-rate exclude each other");
-  if (!a.save_map.empty()) checkSaveMapFolder(a.save_map);
+  // Outputs written at the end are checked now, not after the whole sequence.
+  if (!a.save_map.empty()) io::checkOutputFile(a.save_map, "--save-map");
+  if (!a.octomap.empty()) io::checkOutputFile(a.octomap, "--octomap");
+  if (!a.cloud.empty()) io::checkOutputFile(a.cloud, "--cloud");
+  if (!a.octomap.empty() || !a.cloud.empty()) a.overrides.push_back("DenseMap.enabled=1");
   resolveDefaultFiles(a);
   return a;
 }
@@ -292,19 +359,6 @@ struct MetricsAccumulator {
   }
 };
 
-void makeDirs(const std::string& dir) {
-  std::string cur;
-  std::stringstream ss(dir);
-  std::string part;
-  if (!dir.empty() && dir[0] == '/') cur = "/";
-  while (std::getline(ss, part, '/')) {
-    if (part.empty()) continue;
-    cur += part + "/";
-    ::mkdir(cur.c_str(), 0755);
-  }
-  if (!dirExists(dir)) throw Error(dir + ": cannot create the output folder; check the path and permissions");
-}
-
 // Everything a run reads before its first frame: settings (with the overrides applied before
 // anything loads), camera, sequence, where the boxes come from, vocabulary.
 struct RunSetup {
@@ -350,6 +404,7 @@ void setUpBoxes(const Args& args, RunSetup& r) {
 
 RunSetup setUp(const Args& args) {
   RunSetup r;
+  io::prepareOutputFolder(args.out, io::RunFiles::all(), "--out");
   r.cfg = Config::fromFile(args.config);
   for (const auto& o : args.overrides) r.cfg.setFromAssignment(o);
   r.cam = CameraModel::load(r.cfg);
@@ -360,7 +415,6 @@ RunSetup setUp(const Args& args) {
   if (args.max_frames > 0) r.frames = std::min(r.frames, static_cast<size_t>(args.max_frames));
   setUpBoxes(args, r);
   if (!args.vocabulary.empty()) r.voc = vocabulary::Vocabulary::load(args.vocabulary);
-  makeDirs(args.out);
   r.mask_dir = joinPath(args.sequence, "masks");
   r.has_masks = dirExists(r.mask_dir);
   return r;
@@ -418,9 +472,22 @@ Prepared prepareFrame(const RunSetup& r, size_t i) {
   return p;
 }
 
+// Why frames got no pose, for the summary of a run that tracked too little.
+struct UntrackedCounts {
+  size_t no_image = 0;      // image missing or unreadable: the frame was skipped
+  size_t no_depth = 0;      // no depth image, none of its pixels valid, or not the image's size
+  size_t no_keypoints = 0;  // no keypoint found (black, blank or saturated image)
+  size_t lost = 0;          // tracked but lost (or not yet initialised)
+
+  Json json() const {
+    return Json{{"no_image", no_image}, {"no_depth", no_depth}, {"no_keypoints", no_keypoints}, {"lost", lost}};
+  }
+};
+
 // What the frame loop counted.
 struct LoopResult {
   size_t skipped = 0, processed = 0, lost_reports = 0;
+  UntrackedCounts untracked;
   std::vector<double> frame_ms;
   std::vector<double> latency_ms;  // --camera-rate: arrival to pose
   long camera_offered = 0, camera_dropped = 0;
@@ -430,13 +497,20 @@ struct LoopResult {
   double fps() const { return total_s > 0 ? static_cast<double>(processed + skipped) / total_s : 0.0; }
 };
 
+std::vector<double> stampsOf(const RunSetup& setup) {
+  std::vector<double> stamps;
+  for (size_t i = 0; i < setup.frames; ++i) stamps.push_back(setup.seq.frames()[i].rgb_stamp);
+  return stamps;
+}
+
 // Frames in sequence order, each loaded (and, with every-frame detection, detected) in a
-// worker while the one before it is tracked; --realtime paces them at their stamps.
+// worker while the one before it is tracked; --realtime paces them at their stamps (gaps
+// capped, the wait ends on a stop signal).
 class PrefetchSource {
  public:
   PrefetchSource(const RunSetup& setup, bool realtime)
       : setup_(setup), realtime_(realtime), wall0_(std::chrono::steady_clock::now()),
-        stamp0_(setup.frames ? setup.seq.frames()[0].rgb_stamp : 0) {
+        offsets_(io::playbackSchedule(stampsOf(setup)).offsets) {
     if (setup_.frames > 0) start(0);
   }
   ~PrefetchSource() {
@@ -447,8 +521,9 @@ class PrefetchSource {
     Prepared p = next_.get();
     if (++i_ < setup_.frames) start(i_);
     if (realtime_) {
-      const auto due = wall0_ + std::chrono::duration<double>(p.stamp - stamp0_);
-      std::this_thread::sleep_until(std::chrono::time_point_cast<std::chrono::steady_clock::duration>(due));
+      const auto due = wall0_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                    std::chrono::duration<double>(offsets_[p.index]));
+      if (!io::sleepUntilUnlessStopped(due, stopRequested)) return std::nullopt;
     }
     p.arrival = std::chrono::steady_clock::now();
     return p;
@@ -461,7 +536,7 @@ class PrefetchSource {
   const RunSetup& setup_;
   const bool realtime_;
   const std::chrono::steady_clock::time_point wall0_;
-  const double stamp0_;
+  const std::vector<double> offsets_;  // io::playbackSchedule of the stamps
   size_t i_ = 0;
   std::future<Prepared> next_;
 };
@@ -472,7 +547,7 @@ class CameraSource {
   explicit CameraSource(const RunSetup& setup)
       : feed_(stampsOf(setup), [&setup](size_t i) { return prepareFrame(setup, i); }) {}
   std::optional<Prepared> next() {
-    std::optional<io::CameraFeed<Prepared>::Arrived> a = feed_.next();
+    std::optional<io::CameraFeed<Prepared>::Arrived> a = feed_.next(stopRequested);
     if (!a) return std::nullopt;
     a->frame.arrival = a->due;
     return std::move(a->frame);
@@ -481,25 +556,36 @@ class CameraSource {
   long dropped() const { return feed_.dropped(); }
 
  private:
-  static std::vector<double> stampsOf(const RunSetup& setup) {
-    std::vector<double> stamps;
-    for (size_t i = 0; i < setup.frames; ++i) stamps.push_back(setup.seq.frames()[i].rgb_stamp);
-    return stamps;
-  }
   io::CameraFeed<Prepared> feed_;
 };
 
+// A pacing run would otherwise sit silently through a paused recording or a clock jump.
+void warnAboutStampGaps(const RunSetup& setup, const char* flag) {
+  const std::vector<double> stamps = stampsOf(setup);
+  const io::PlaybackSchedule s = io::playbackSchedule(stamps);
+  if (s.gaps_capped == 0) return;
+  const size_t i = s.first_capped;
+  std::fprintf(stderr,
+               "warning: stamps jump forward %.3f s from %.6f to %.6f (frame %zu)%s; %s plays a gap over %.0f s "
+               "as %.0f s\n",
+               stamps[i] - stamps[i - 1], stamps[i - 1], stamps[i], i,
+               s.gaps_capped > 1 ? (", and " + std::to_string(s.gaps_capped - 1) + " more such gaps").c_str() : "",
+               flag, io::kMaxPlaybackGapS, io::kMaxPlaybackGapS);
+}
+
 // Every box screened, per frame, in the synthetic boxes.txt format: to inspect the detector
 // and the box tracker offline, or to score them against the ground truth.
-void writeScreenedBoxes(std::ofstream& out, double stamp, const detection::Boxes& boxes) {
+std::string screenedBoxLines(double stamp, const detection::Boxes& boxes) {
+  std::string text;
   int k = 0;
   char line[160];
   for (const auto& b : boxes) {
     std::snprintf(line, sizeof line, "%.6f %d %s %.1f %.1f %.1f %.1f %.3f %d\n", stamp, k++,
                   b.label.empty() ? "person" : b.label.c_str(), b.rect.x, b.rect.y, b.rect.x + b.rect.width,
                   b.rect.y + b.rect.height, b.score, b.tracked ? 1 : 0);
-    out << line;
+    text += line;
   }
+  return text;
 }
 
 // Retention counts static keypoints inside the boxes this run used (none in modes off and
@@ -532,35 +618,63 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
   if (!newest->error.empty()) p.warning += (p.warning.empty() ? "" : "; ") + ("detector failed: " + newest->error);
 }
 
-void trackFrame(slam::System& system, const Prepared& p, std::ofstream& boxes_out, LoopResult& res) {
+// The files the frame loop grows (io::RunFiles): poses as tracked, boxes as screened.
+struct PartialOutputs {
+  std::unique_ptr<io::IncrementalFile> trajectory;
+  std::unique_ptr<io::IncrementalFile> boxes;  // modes with detection only
+};
+
+bool depthUnusable(const Prepared& p) {
+  return p.depth.empty() || p.depth.channels() != 1 || p.depth.size() != p.bgr.size() ||
+         cv::countNonZero(p.depth > 0) == 0;
+}
+
+// The first frame of each kind gets a warning; the rest are counted for the summary.
+void countUntracked(const slam::System& system, const Prepared& p, UntrackedCounts& c) {
+  auto first = [&p](size_t& n, const char* why) {
+    if (n++ == 0)
+      std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s; frames like it are counted in the summary\n", p.index,
+                   p.stamp, why);
+  };
+  if (depthUnusable(p))
+    first(c.no_depth, "no usable depth (missing, no valid pixel, or not the size of the image)");
+  else if (system.lastFrame().keypoints.empty())
+    first(c.no_keypoints, "no keypoint found (black, blank or saturated image?)");
+  else
+    ++c.lost;
+}
+
+void trackFrame(slam::System& system, const Prepared& p, PartialOutputs& outputs, LoopResult& res) {
   if (!p.warning.empty()) std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s\n", p.index, p.stamp, p.warning.c_str());
   if (p.detection_ms >= 0) system.recordDetectionTime(p.detection_ms);
   if (!p.has_image) {
     ++res.skipped;
+    ++res.untracked.no_image;
     return;
   }
   const slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes, p.detector_ran);
-  if (r.state != slam::TrackingState::Ok) ++res.lost_reports;
+  if (r.state == slam::TrackingState::Ok) {
+    outputs.trajectory->append(io::formatTumPose(StampedPose{p.stamp, r.T_wc}));
+  } else {
+    ++res.lost_reports;
+    countUntracked(system, p, res.untracked);
+  }
   ++res.processed;
-  if (boxes_out.is_open()) writeScreenedBoxes(boxes_out, p.stamp, system.lastBoxes());
+  if (outputs.boxes) outputs.boxes->append(screenedBoxLines(p.stamp, system.lastBoxes()));
   evaluateFrame(system, p, res.metrics);
 }
 
 template <class Source>
-void runFrames(Source& source, const Args& args, const RunSetup& setup, slam::System& system, LoopResult& res) {
+void runFrames(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
+               LoopResult& res) {
   ProgressBar bar("yolo_slam_run", setup.frames);
-  std::ofstream boxes_out;
-  if (setup.stages.detection) {
-    boxes_out.open(joinPath(args.out, "boxes_screened.txt"));
-    boxes_out << "# rgb_stamp index label x1 y1 x2 y2 score tracked\n";
-  }
   detection::BoxFeed feed(setup.max_box_age_s);
-  while (!g_stop) {
+  while (!stopRequested()) {
     Stopwatch fsw;
     std::optional<Prepared> p = source.next();
     if (!p) break;
     attachAsyncBoxes(setup, feed, *p, system, res);
-    trackFrame(system, *p, boxes_out, res);
+    trackFrame(system, *p, outputs, res);
     res.frame_ms.push_back(fsw.ms());
     res.latency_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p->arrival).count());
@@ -571,17 +685,19 @@ void runFrames(Source& source, const Args& args, const RunSetup& setup, slam::Sy
   bar.finish();
 }
 
-LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system) {
+LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system, PartialOutputs& outputs) {
   LoopResult res;
   Stopwatch total;
   if (args.camera_rate) {
+    warnAboutStampGaps(setup, "--camera-rate");
     CameraSource feed(setup);
-    runFrames(feed, args, setup, system, res);
+    runFrames(feed, setup, system, outputs, res);
     res.camera_offered = feed.offered();
     res.camera_dropped = feed.dropped();
   } else {
+    if (args.realtime) warnAboutStampGaps(setup, "--realtime");
     PrefetchSource source(setup, args.realtime);
-    runFrames(source, args, setup, system, res);
+    runFrames(source, setup, system, outputs, res);
   }
   if (setup.async) setup.async->waitIdle();
   res.total_s = total.ms() / 1000.0;
@@ -636,21 +752,130 @@ Json mapFilesJson(const Args& args, const MapFiles& maps) {
               {"saved", mapFileInfoJson(args.save_map, maps.saved)}};
 }
 
-Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res, size_t poses,
-                  const AteSummary& ate, const slam::SystemStats& s, const MapFiles& maps) {
+// How a run ended: stats.json "complete", "status" and "reason", and the exit code.
+struct Outcome {
+  std::string status;  // "finished", "interrupted" or "too few frames tracked"
+  std::string reason;  // why the run is not complete; empty when it is
+  int exit_code = 0;
+  size_t frames = 0, tracked = 0;  // frames given to the pipeline, frames with a pose
+  double tracked_fraction = 0;
+  bool complete() const { return reason.empty(); }
+};
+
+std::string signalName(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "signal " + std::to_string(sig);
+  }
+}
+
+std::string untrackedSummary(const Outcome& o, const UntrackedCounts& u) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "tracked %zu of %zu frames (%.1f%%): %zu without an image, %zu without usable depth, %zu without "
+                "keypoints, %zu lost",
+                o.tracked, o.frames, 100.0 * o.tracked_fraction, u.no_image, u.no_depth, u.no_keypoints, u.lost);
+  return buf;
+}
+
+Outcome outcomeOf(const Args& args, const LoopResult& res, const slam::SystemStats& s) {
+  Outcome o;
+  o.frames = res.processed + res.skipped;
+  o.tracked = s.tracked;
+  o.tracked_fraction = o.frames > 0 ? static_cast<double>(o.tracked) / o.frames : 0.0;
+  if (g_stop != 0) {
+    o.status = "interrupted";
+    o.reason = "stopped by " + signalName(g_stop) + " after " + std::to_string(o.frames) + " frames";
+    o.exit_code = kExitSignalBase + g_stop;
+  } else if (o.tracked_fraction < args.min_tracked) {
+    o.status = "too few frames tracked";
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " (below --min-tracked %g)", args.min_tracked);
+    o.reason = untrackedSummary(o, res.untracked) + buf;
+    o.exit_code = kExitTooFewTracked;
+  } else {
+    o.status = "finished";
+  }
+  return o;
+}
+
+// stats.json while the run goes on: what a reader finds after a kill (SIGKILL, a crash).
+Json runningStatsJson(const Args& args) {
+  return Json{{"complete", false},
+              {"status", "running"},
+              {"reason", std::string("the run has not finished: it is still going, or it was killed or failed "
+                                     "before writing its results; ") +
+                             io::RunFiles::kPartialTrajectory + " holds the tracking poses estimated so far"},
+              {"sequence", args.sequence},
+              {"config", args.config},
+              {"pid", static_cast<long>(::getpid())},
+              {"files", Json{{"partial_trajectory", io::RunFiles::kPartialTrajectory}}}};
+}
+
+// Which files belong to this run (written before stats.json; paths relative to OUT, the map
+// as given).
+Json runFilesJson(const Args& args, bool boxes_written) {
+  return Json{{"camera_trajectory", io::RunFiles::kCameraTrajectory},
+              {"keyframe_trajectory", io::RunFiles::kKeyFrameTrajectory},
+              {"boxes_screened", boxes_written ? Json(io::RunFiles::kBoxesScreened) : Json(nullptr)},
+              {"map", args.save_map.empty() ? Json(nullptr) : Json(args.save_map)}};
+}
+
+// Takes the folder for this run before the first frame: the previous run's files go (a folder
+// never mixes two runs), stats.json says "running", and the partial files are opened.
+PartialOutputs claimRunFolder(const Args& args, const RunSetup& setup) {
+  io::removePreviousRun(args.out);
+  io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(runningStatsJson(args)));
+  PartialOutputs p;
+  p.trajectory = std::make_unique<io::IncrementalFile>(joinPath(args.out, io::RunFiles::kPartialTrajectory),
+                                                       io::kTumTrajectoryHeader);
+  if (setup.stages.detection)
+    p.boxes = std::make_unique<io::IncrementalFile>(joinPath(args.out, io::RunFiles::kPartialBoxes),
+                                                    "# rgb_stamp index label x1 y1 x2 y2 score tracked\n");
+  return p;
+}
+
+// The final stats.json: the completion marker and the run's files first, then the figures.
+struct FinalStats {
+  const Outcome& outcome;
+  const LoopResult& res;
+  size_t poses;
+  const AteSummary& ate;
+  const slam::SystemStats& s;
+  const MapFiles& maps;
+  bool boxes_written;
+};
+
+Json trackingJson(const Args& args, const FinalStats& f) {
+  return Json{{"frames_read", f.outcome.frames},
+              {"tracked_fraction", jsonNumber(f.outcome.tracked_fraction)},
+              {"min_tracked", args.min_tracked},
+              {"untracked", f.res.untracked.json()}};
+}
+
+Json runStatsJson(const Args& args, const RunSetup& setup, const FinalStats& f) {
   const screening::Stages& st = setup.stages;
-  Json j{{"sequence", args.sequence},
+  const LoopResult& res = f.res;
+  Json j{{"complete", f.outcome.complete()},
+         {"status", f.outcome.status},
+         {"reason", f.outcome.reason},
+         {"files", runFilesJson(args, f.boxes_written)},
+         {"sequence", args.sequence},
          {"config", args.config},
          {"dynamic_mode", screening::toString(setup.options.screening.mode)},
          {"boxes", setup.boxes_source},
          {"interrupted", g_stop != 0},
+         {"signal", g_stop != 0 ? Json(signalName(g_stop)) : Json(nullptr)},
+         {"tracking", trackingJson(args, f)},
          {"frames_skipped", res.skipped},
-         {"trajectory_poses", poses},
-         {"ate_rmse_m", jsonNumber(ate.rmse)},
-         {"ate_pairs", ate.pairs},
+         {"trajectory_poses", f.poses},
+         {"ate_rmse_m", jsonNumber(f.ate.rmse)},
+         {"ate_pairs", f.ate.pairs},
          {"wall_time_s", jsonNumber(res.total_s)},
          {"fps", jsonNumber(res.fps())}};
-  j.update(slam::statsCountsJson(s));
+  j.update(slam::statsCountsJson(f.s));
   j["track_boxes"] = st.box_tracking;
   j["propagate_labels"] = st.label_propagation;
   j["static_box_veto"] = st.static_box_veto;
@@ -658,9 +883,9 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const LoopResult& res
   j["sequential"] = setup.options.sequential;
   j["vocabulary"] = args.vocabulary;
   j["screening_metrics"] = res.metrics.json();
-  j["timings"] = slam::statsTimingsJson(s, {{"frame", res.frame_ms}, {"latency", res.latency_ms}});
+  j["timings"] = slam::statsTimingsJson(f.s, {{"frame", res.frame_ms}, {"latency", res.latency_ms}});
   j["detection"] = detectionJson(setup, res);
-  j["map_file"] = mapFilesJson(args, maps);
+  j["map_file"] = mapFilesJson(args, f.maps);
   if (args.camera_rate)
     j["camera"] = Json{{"offered", res.camera_offered},
                        {"processed", res.processed + res.skipped},
@@ -701,6 +926,58 @@ void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary
                 percent(m.dynamic_outside_dropped, m.dynamic_outside_boxes).c_str());
 }
 
+// The dense map's files (--octomap, --cloud) after shutdown, and its stats.json object (null
+// when the dense map is off).
+Json writeDenseMap(const Args& args, const slam::System& system) {
+  const mapping::DenseMapper* dense = system.denseMap();
+  if (!dense) return nullptr;
+  if (!args.octomap.empty()) dense->writeOctomap(args.octomap);
+  if (!args.cloud.empty()) dense->writeCloud(args.cloud);
+  const mapping::DenseMapStats d = dense->stats();
+  std::printf("dense map: %zu keyframes, %zu occupied voxels, %zu cloud points, %.1f MB\n", d.keyframes, d.voxels,
+              d.points, d.memory_bytes / (1024.0 * 1024.0));
+  Json j = d;
+  j["octomap"] = args.octomap.empty() ? Json(nullptr) : Json(args.octomap);
+  j["cloud"] = args.cloud.empty() ? Json(nullptr) : Json(args.cloud);
+  return j;
+}
+
+// The end of a run, in an order that a kill at any point leaves readable (README "What happens
+// when things go wrong"): the final trajectories (each atomic), the boxes renamed into place,
+// the map files (--save-map, then --octomap and --cloud), then stats.json, the completion
+// marker, and last the partial trajectory goes.
+int finishRun(const Args& args, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
+              const LoopResult& res, MapFiles& maps) {
+  system.waitForLocalMapping();
+  system.shutdown();
+  const Trajectory traj = system.cameraTrajectory();
+  io::writeTrajectory(joinPath(args.out, io::RunFiles::kCameraTrajectory), traj);
+  io::writeTrajectory(joinPath(args.out, io::RunFiles::kKeyFrameTrajectory), system.keyframeTrajectory());
+  const bool boxes_written = outputs.boxes && outputs.boxes->finishAs(joinPath(args.out, io::RunFiles::kBoxesScreened));
+  if (!args.save_map.empty()) {
+    maps.saved = system.saveMap(args.save_map);
+    std::printf("saved map %s: %zu keyframes, %zu points, %zu bytes in %.0f ms\n", args.save_map.c_str(),
+                maps.saved->keyframes, maps.saved->map_points, maps.saved->bytes, maps.saved->ms);
+  }
+  const Json dense = writeDenseMap(args, system);
+  const AteSummary ate = ateOf(setup.seq, traj);
+  const slam::SystemStats s = system.stats();
+  const Outcome outcome = outcomeOf(args, res, s);
+  const FinalStats stats{outcome, res, traj.size(), ate, s, maps, boxes_written};
+  Json stats_json = runStatsJson(args, setup, stats);
+  if (!dense.is_null()) stats_json["dense_map"] = dense;
+  io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(stats_json));
+  outputs.trajectory->remove();
+  printSummary(setup, res, ate, s);
+  const std::string boxes_name = boxes_written ? std::string(io::RunFiles::kBoxesScreened) + "," : "";
+  std::printf("wrote %s/{%s,%s,%s%s}\n", args.out.c_str(), io::RunFiles::kCameraTrajectory,
+              io::RunFiles::kKeyFrameTrajectory, boxes_name.c_str(), io::RunFiles::kStats);
+  if (outcome.exit_code == kExitTooFewTracked)
+    std::fprintf(stderr, "error: %s; everything is written to %s (exit code %d; --min-tracked 0 accepts such a run)\n",
+                 outcome.reason.c_str(), args.out.c_str(), kExitTooFewTracked);
+  return outcome.exit_code;
+}
+
 int run(const Args& args) {
   RunSetup setup = setUp(args);
   slam::System system(setup.cam, setup.options, setup.voc);
@@ -712,35 +989,20 @@ int run(const Args& args) {
     std::fprintf(stderr, "yolo_slam_run: loaded map %s: %zu keyframes, %zu points in %.0f ms\n", args.load_map.c_str(),
                  maps.loaded->keyframes, maps.loaded->map_points, maps.loaded->ms);
   }
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
-  // Printed once the handlers are in place (the Ctrl-C test waits for this line).
+  installSignalHandlers();
+  PartialOutputs outputs = claimRunFolder(args, setup);
+  // Printed once the handlers are in place and the folder is claimed (the signal tests wait
+  // for this line).
   std::fprintf(stderr, "yolo_slam_run: %zu frames from %s, dynamic mode %s, boxes: %s, vocabulary: %s%s\n",
                setup.frames, args.sequence.c_str(), screening::toString(setup.options.screening.mode).c_str(),
                setup.boxes_source.c_str(), args.vocabulary.empty() ? "none (no BoW)" : args.vocabulary.c_str(),
                setup.has_masks ? ", screening metrics from masks/" : "");
 
-  const LoopResult res = processFrames(args, setup, system);
+  const LoopResult res = processFrames(args, setup, system, outputs);
   if (g_stop)
-    std::fprintf(stderr, "interrupted: stopping after %zu frames and writing the results\n", res.processed + res.skipped);
-
-  system.waitForLocalMapping();
-  system.shutdown();
-  const Trajectory traj = system.cameraTrajectory();
-  io::writeTrajectory(joinPath(args.out, "CameraTrajectory.txt"), traj);
-  io::writeTrajectory(joinPath(args.out, "KeyFrameTrajectory.txt"), system.keyframeTrajectory());
-  if (!args.save_map.empty()) {
-    maps.saved = system.saveMap(args.save_map);
-    std::printf("saved map %s: %zu keyframes, %zu points, %zu bytes in %.0f ms\n", args.save_map.c_str(),
-                maps.saved->keyframes, maps.saved->map_points, maps.saved->bytes, maps.saved->ms);
-  }
-  const AteSummary ate = ateOf(setup.seq, traj);
-  const slam::SystemStats s = system.stats();
-  io::writeFileAtomic(joinPath(args.out, "stats.json"),
-                      dumpJson(runStatsJson(args, setup, res, traj.size(), ate, s, maps)));
-  printSummary(setup, res, ate, s);
-  std::printf("wrote %s/{CameraTrajectory.txt,KeyFrameTrajectory.txt,stats.json}\n", args.out.c_str());
-  return g_stop ? 130 : 0;
+    std::fprintf(stderr, "interrupted by %s: stopping after %zu frames and writing the results\n",
+                 signalName(g_stop).c_str(), res.processed + res.skipped);
+  return finishRun(args, setup, system, outputs, res, maps);
 }
 
 }  // namespace
@@ -754,12 +1016,12 @@ int main(int argc, char** argv) {
     auto nl = msg.find('\n');
     std::fprintf(stderr, "error: %s\n", msg.substr(0, nl).c_str());
     if (nl != std::string::npos) std::fputs(msg.substr(nl + 1).c_str(), stderr);
-    return 1;
+    return kExitError;
   } catch (const cv::Exception& e) {
     std::fprintf(stderr, "error: OpenCV: %s\n", e.what());
-    return 1;
+    return kExitError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    return kExitError;
   }
 }

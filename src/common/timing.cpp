@@ -3,8 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <time.h>
 
 namespace yolo_slam {
+
+double threadCpuMs() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
 
 Summary summarize(std::vector<double> v) {
   Summary s;

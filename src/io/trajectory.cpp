@@ -1,10 +1,10 @@
 #include "yolo_slam/io/trajectory.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/io/atomic_file.h"
 #include "yolo_slam/io/text_table.h"
 
 #include <cstdio>
-#include <memory>
 
 namespace yolo_slam {
 namespace io {
@@ -30,25 +30,23 @@ Trajectory readTrajectory(const std::string& path) {
   return traj;
 }
 
+const char* const kTumTrajectoryHeader = "# timestamp tx ty tz qx qy qz qw\n";
+
+std::string formatTumPose(const StampedPose& p) {
+  Eigen::Quaterniond q(p.T_wc.rotation());
+  q.normalize();
+  if (q.w() < 0) q.coeffs() = -q.coeffs();  // one canonical sign
+  const Eigen::Vector3d& t = p.T_wc.translation();
+  char line[256];
+  std::snprintf(line, sizeof line, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", p.stamp, t.x(), t.y(), t.z(), q.x(),
+                q.y(), q.z(), q.w());
+  return line;
+}
+
 void writeTrajectory(const std::string& path, const Trajectory& traj) {
-  const std::string tmp = path + ".tmp";
-  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(tmp.c_str(), "w"), &std::fclose);
-  if (!f) throw Error(path + ": cannot write trajectory (does the folder exist and is it writable?)");
-  bool ok = std::fprintf(f.get(), "# timestamp tx ty tz qx qy qz qw\n") > 0;
-  for (const StampedPose& p : traj) {
-    Eigen::Quaterniond q(p.T_wc.rotation());
-    q.normalize();
-    if (q.w() < 0) q.coeffs() = -q.coeffs();  // one canonical sign
-    const Eigen::Vector3d& t = p.T_wc.translation();
-    ok = ok && std::fprintf(f.get(), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", p.stamp, t.x(),
-                            t.y(), t.z(), q.x(), q.y(), q.z(), q.w()) > 0;
-  }
-  ok = (std::fflush(f.get()) == 0) && ok;
-  ok = (std::fclose(f.release()) == 0) && ok;
-  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw Error(path + ": failed to write trajectory (disk full or not writable?)");
-  }
+  std::string text = kTumTrajectoryHeader;
+  for (const StampedPose& p : traj) text += formatTumPose(p);
+  writeFileAtomic(path, text);
 }
 
 }  // namespace io

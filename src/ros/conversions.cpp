@@ -1,7 +1,9 @@
 #include "yolo_slam/ros/conversions.h"
 
+#include <cv_bridge/cv_bridge.h>
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
 #include <cstring>
@@ -146,10 +148,9 @@ void checkImage(const sensor_msgs::Image& msg, const std::string& topic, int cha
                 " " + msg.encoding + ")");
 }
 
-cv::Mat wrap(const sensor_msgs::Image& msg, int type) {
-  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
-                 const_cast<uint8_t*>(msg.data.data()), msg.step);
-}
+// cv_bridge's view of the message's pixels (no copy). cv_bridge does not compare step and data
+// size with the image size: checkImage above does, before any pixel is read.
+cv::Mat view(const sensor_msgs::Image& msg) { return cv_bridge::toCvShare(msg, nullptr)->image; }
 
 }  // namespace
 
@@ -158,7 +159,7 @@ cv::Mat imageView(const sensor_msgs::Image& msg, const std::string& topic, bool&
   if (e == enc::RGB8 || e == enc::BGR8) {
     checkImage(msg, topic, 3, 1);
     is_rgb = e == enc::RGB8;
-    return wrap(msg, CV_8UC3);
+    return view(msg);
   }
   is_rgb = false;
   return imageToBgr(msg, topic);
@@ -166,36 +167,27 @@ cv::Mat imageView(const sensor_msgs::Image& msg, const std::string& topic, bool&
 
 cv::Mat imageToBgr(const sensor_msgs::Image& msg, const std::string& topic) {
   const std::string& e = msg.encoding;
-  cv::Mat out;
-  if (e == enc::RGB8 || e == enc::BGR8) {
-    checkImage(msg, topic, 3, 1);
-    if (e == enc::RGB8)
-      cv::cvtColor(wrap(msg, CV_8UC3), out, cv::COLOR_RGB2BGR);
-    else
-      out = wrap(msg, CV_8UC3).clone();
-  } else if (e == enc::RGBA8 || e == enc::BGRA8) {
-    checkImage(msg, topic, 4, 1);
-    cv::cvtColor(wrap(msg, CV_8UC4), out, e == enc::RGBA8 ? cv::COLOR_RGBA2BGR : cv::COLOR_BGRA2BGR);
-  } else if (e == enc::MONO8) {
-    checkImage(msg, topic, 1, 1);
-    cv::cvtColor(wrap(msg, CV_8UC1), out, cv::COLOR_GRAY2BGR);
-  } else {
+  int channels = 0;
+  if (e == enc::RGB8 || e == enc::BGR8) channels = 3;
+  else if (e == enc::RGBA8 || e == enc::BGRA8) channels = 4;
+  else if (e == enc::MONO8) channels = 1;
+  else
     throw Error("unsupported colour encoding '" + e + "' on " + topic +
                 "; expected rgb8, bgr8, rgba8, bgra8 or mono8 (is a depth topic remapped "
                 "to the colour input?)");
-  }
-  return out;
+  checkImage(msg, topic, channels, 1);
+  return cv_bridge::toCvCopy(msg, enc::BGR8)->image;
 }
 
 cv::Mat depthToMetres(const sensor_msgs::Image& msg, const std::string& topic, double factor_16u) {
   const std::string& e = msg.encoding;
   if (e == enc::TYPE_16UC1 || e == enc::MONO16) {
     checkImage(msg, topic, 1, 2);
-    return io::decodeDepth(wrap(msg, CV_16UC1), factor_16u, topic);
+    return io::decodeDepth(view(msg), factor_16u, topic);
   }
   if (e == enc::TYPE_32FC1) {
     checkImage(msg, topic, 1, 4);
-    return io::decodeDepth(wrap(msg, CV_32FC1), 1.0, topic);
+    return io::decodeDepth(view(msg), 1.0, topic);
   }
   throw Error("unsupported depth encoding '" + e + "' on " + topic +
               "; expected 16UC1 (millimetres) or 32FC1 (metres), see REP 118");
@@ -251,41 +243,25 @@ CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraMode
   return cam;
 }
 
-geometry_msgs::Pose poseToMsg(const Pose& T) {
-  geometry_msgs::Pose m;
-  const Eigen::Quaterniond q(T.linear());
-  m.position.x = T.translation().x();
-  m.position.y = T.translation().y();
-  m.position.z = T.translation().z();
-  m.orientation.x = q.x();
-  m.orientation.y = q.y();
-  m.orientation.z = q.z();
-  m.orientation.w = q.w();
-  return m;
-}
+geometry_msgs::Pose poseToMsg(const Pose& T) { return tf2::toMsg(T); }
 
+// Quaternions from other nodes may be slightly off unit length: makePose normalises them.
 Pose poseFromMsg(const geometry_msgs::Pose& m) {
-  return makePose(Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y,
-                                     m.orientation.z),
-                  Eigen::Vector3d(m.position.x, m.position.y, m.position.z));
+  Eigen::Quaterniond q;
+  Eigen::Vector3d t;
+  tf2::fromMsg(m.orientation, q);
+  tf2::fromMsg(m.position, t);
+  return makePose(q, t);
 }
 
-geometry_msgs::Transform transformToMsg(const Pose& T) {
-  geometry_msgs::Transform m;
-  const Eigen::Quaterniond q(T.linear());
-  m.translation.x = T.translation().x();
-  m.translation.y = T.translation().y();
-  m.translation.z = T.translation().z();
-  m.rotation.x = q.x();
-  m.rotation.y = q.y();
-  m.rotation.z = q.z();
-  m.rotation.w = q.w();
-  return m;
-}
+geometry_msgs::Transform transformToMsg(const Pose& T) { return tf2::eigenToTransform(T).transform; }
 
 Pose transformFromMsg(const geometry_msgs::Transform& m) {
-  return makePose(Eigen::Quaterniond(m.rotation.w, m.rotation.x, m.rotation.y, m.rotation.z),
-                  Eigen::Vector3d(m.translation.x, m.translation.y, m.translation.z));
+  Eigen::Quaterniond q;
+  Eigen::Vector3d t;
+  tf2::fromMsg(m.rotation, q);
+  tf2::fromMsg(m.translation, t);
+  return makePose(q, t);
 }
 
 }  // namespace ros1

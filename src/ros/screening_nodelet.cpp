@@ -7,7 +7,8 @@
 // synchronised (every frame waits for its detection, the paper's pipeline). Frames the
 // synchroniser drops are counted (never silent): a warning per drop burst and a /diagnostics
 // status every second.
-#include <diagnostic_msgs/DiagnosticArray.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/synchronizer.h>
@@ -52,6 +53,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("use_boxes", use_boxes_, true);
     pnh.param("use_camera_info", use_camera_info_, true);
     pnh.param("depth_factor_16u", depth_factor_16u_, 1000.0);
+    pnh.param("assume_registered", assume_registered_, false);
     double max_interval = 0.05;
     pnh.param("sync_max_interval", max_interval, 0.05);
     try {
@@ -79,7 +81,12 @@ class ScreeningNodelet : public nodelet::Nodelet {
     }
 
     pub_ = nh.advertise<KeypointFrame>("yolo_slam/keypoint_frame", queue_size);
-    diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("yolo_slam");
+    updater_->add("frames", this, &ScreeningNodelet::fillDiagnostics);
+    rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+        diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_), "published frame rate");
+    updater_->add(*rate_);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
     rgb_sub_.subscribe(nh, "camera/rgb/image_color", queue_size);
@@ -101,8 +108,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
       sync2_->setMaxIntervalDuration(::ros::Duration(max_interval));
       sync2_->registerCallback(&ScreeningNodelet::onFrame2, this);
     }
+    // Wall time, not Updater::update's ROS-time period: diagnostics keep coming while a bag's
+    // clock stands still.
     diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
-                                     [this](const ::ros::WallTimerEvent&) { publishDiagnostics(); });
+                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -156,6 +165,23 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
 
+  // Depth must be registered to colour (pixel for pixel). A driver marks registered depth with
+  // the colour frame id (openni2_launch's depth_registered topics); plain depth/ topics carry
+  // the depth camera's frame and would be screened wrongly without a word.
+  void checkRegistered(const Image& rgb, const Image& depth) const {
+    if (assume_registered_) return;
+    auto bare = [](std::string f) {
+      while (!f.empty() && f.front() == '/') f.erase(0, 1);
+      return f;
+    };
+    if (bare(rgb.header.frame_id) == bare(depth.header.frame_id)) return;
+    throw Error("depth on " + depth_sub_.getTopic() + " is in frame '" + depth.header.frame_id + "', colour on " +
+                rgb_sub_.getTopic() + " in '" + rgb.header.frame_id +
+                "': depth is not registered to colour. Use the driver's registered depth (openni2_launch: "
+                "depth_registered:=true, topic camera/depth_registered/image_raw), or set ~assume_registered true "
+                "if the images are registered under other frame names (TUM bags)");
+  }
+
   void process(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const BoundingBoxes::ConstPtr& boxes_msg) {
     size_t dropped_now = 0;
@@ -179,6 +205,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       bool is_rgb = true;
       const cv::Mat image = imageView(*rgb, rgb_sub_.getTopic(), is_rgb);
       const cv::Mat depth_m = depthToMetres(*depth, depth_sub_.getTopic(), depth_factor_16u_);
+      checkRegistered(*rgb, *depth);
       if (depth_m.size() != image.size())
         throw Error("depth image on " + depth_sub_.getTopic() + " is " +
                     std::to_string(depth_m.cols) + "x" + std::to_string(depth_m.rows) +
@@ -198,6 +225,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       out->index = static_cast<uint32_t>(++index_);
       toMsg(fe.frame, fe.boxes, *out);  // the boxes screened: detections and carried ones
       pub_.publish(out);
+      rate_->tick();
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++published_;
       ms_.push_back(sw.ms());
@@ -212,10 +240,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     }
   }
 
-  void publishDiagnostics() {
-    diagnostic_msgs::DiagnosticStatus st;
-    st.name = getName() + ": frames";
-    st.hardware_id = "yolo_slam";
+  void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
     Summary s, ext, scr;
     size_t rgb = 0, synced = 0, published = 0;
     {
@@ -228,35 +253,25 @@ class ScreeningNodelet : public nodelet::Nodelet {
       published = published_;
     }
     const size_t dropped = dropped_, rejected = rejected_;
-    st.level = dropped + rejected > 0 ? diagnostic_msgs::DiagnosticStatus::WARN
-                                      : diagnostic_msgs::DiagnosticStatus::OK;
-    st.message = dropped + rejected > 0
-                     ? std::to_string(dropped) + " dropped, " + std::to_string(rejected) + " rejected"
-                     : "no frame dropped";
-    auto kv = [&](const std::string& k, const std::string& v) {
-      diagnostic_msgs::KeyValue p;
-      p.key = k;
-      p.value = v;
-      st.values.push_back(p);
-    };
-    kv("rgb_received", std::to_string(rgb));
-    kv("synchronised", std::to_string(synced));
-    kv("published", std::to_string(published));
-    kv("dropped_by_sync", std::to_string(dropped));
-    kv("rejected_bad_input", std::to_string(rejected));
-    kv("median_ms", std::to_string(s.median));
-    kv("extraction_median_ms", std::to_string(ext.median));
-    kv("screening_median_ms", std::to_string(scr.median));
-    kv("boxes", !use_boxes_ ? "none" : async_boxes_ ? "async" : "synchronised");
+    if (dropped + rejected > 0)
+      st.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 std::to_string(dropped) + " dropped, " + std::to_string(rejected) + " rejected");
+    else
+      st.summary(diagnostic_msgs::DiagnosticStatus::OK, "no frame dropped");
+    st.add("rgb_received", rgb);
+    st.add("synchronised", synced);
+    st.add("published", published);
+    st.add("dropped_by_sync", dropped);
+    st.add("rejected_bad_input", rejected);
+    st.add("median_ms", s.median);
+    st.add("extraction_median_ms", ext.median);
+    st.add("screening_median_ms", scr.median);
+    st.add("boxes", !use_boxes_ ? "none" : async_boxes_ ? "async" : "synchronised");
     if (async_boxes_) {
-      kv("boxes_received", std::to_string(boxesReceived()));
-      kv("frames_with_new_boxes", std::to_string(frames_with_new_boxes_.load()));
-      kv("boxes_too_old", std::to_string(boxes_too_old_.load()));
+      st.add("boxes_received", boxesReceived());
+      st.add("frames_with_new_boxes", frames_with_new_boxes_.load());
+      st.add("boxes_too_old", boxes_too_old_.load());
     }
-    diagnostic_msgs::DiagnosticArray arr;
-    arr.header.stamp = ::ros::Time::now();
-    arr.status.push_back(st);
-    diag_pub_.publish(arr);
   }
 
   long boxesReceived() {
@@ -277,6 +292,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
   std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
+  bool assume_registered_ = false;  // skip the depth/colour frame id check
   // Extraction and screening (stateful between frames; used by the frame callback only, which
   // the synchroniser serialises, like index_).
   std::unique_ptr<frontend::FrontEnd> front_end_;
@@ -295,7 +311,14 @@ class ScreeningNodelet : public nodelet::Nodelet {
   std::unique_ptr<Sync3> sync3_;
   std::unique_ptr<Sync2> sync2_;
   ::ros::Subscriber info_sub_, async_boxes_sub_;
-  ::ros::Publisher pub_, diag_pub_;
+  ::ros::Publisher pub_;
+  // Published frame rate outside these bounds is a warning (a camera gives 30 Hz).
+  // (FrequencyStatus keeps pointers to them and may read them at any update.)
+  double min_rate_hz_ = 5.0, max_rate_hz_ = 60.0;
+  // Diagnostics on /diagnostics: the counters above (the fill callback reads them under
+  // stats_mutex_ or as atomics) and the published frame rate (FrequencyStatus locks inside).
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_;
   ::ros::WallTimer diag_timer_;
 };
 

@@ -1,7 +1,8 @@
-// yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Outputs follow REP 103 /
-// REP 105: tf map -> odom -> base_link (or map -> camera when asked), the base pose, its path,
-// the static map points, keyframes with covisibility edges and a debug image; services reset,
-// save_trajectory (TUM format), set_localization_mode, save_map and load_map (map files).
+// yolo_slam/Slam: tracking + mapping on the screened keypoint frames. Pose, odometry and tf follow
+// REP 103 / REP 105 (pose_output.h); also the path, the static map points, keyframes with
+// covisibility edges and a debug image; services reset, save_trajectory (TUM format),
+// set_localization_mode, save_map and load_map (map files).
+#include <cv_bridge/cv_bridge.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -16,9 +17,6 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_broadcaster.h>
-#include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <opencv2/imgproc.hpp>
 
@@ -28,7 +26,9 @@
 #include <memory>
 #include <mutex>
 
+#include "dense_map_publisher.h"
 #include "nodelet_common.h"
+#include "pose_output.h"
 #include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/MapFile.h"
 #include "yolo_slam/SaveTrajectory.h"
@@ -54,16 +54,6 @@ const char* stateName(slam::TrackingState s) {
   return "?";
 }
 
-// [x y z qx qy qz qw] -> Pose; throws Error naming the parameter.
-Pose poseFromParam(const std::vector<double>& v, const std::string& name) {
-  if (v.size() != 7)
-    throw Error("parameter " + name + " needs 7 numbers [x, y, z, qx, qy, qz, qw], got " +
-                std::to_string(v.size()));
-  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-  if (q.norm() < 1e-9) throw Error("parameter " + name + " has a zero quaternion");
-  return makePose(q, Eigen::Vector3d(v[0], v[1], v[2]));
-}
-
 }  // namespace
 
 class SlamNodelet : public nodelet::Nodelet {
@@ -71,6 +61,7 @@ class SlamNodelet : public nodelet::Nodelet {
   ~SlamNodelet() override {
     map_timer_.stop();
     diag_timer_.stop();
+    dense_timer_.stop();
     std::lock_guard<std::mutex> lock(system_mutex_);
     if (!system_) return;
     if (!trajectory_path_.empty()) {
@@ -83,6 +74,7 @@ class SlamNodelet : public nodelet::Nodelet {
       }
     }
     system_->shutdown();
+    saveOctomapAtShutdown();
   }
 
  private:
@@ -92,26 +84,24 @@ class SlamNodelet : public nodelet::Nodelet {
     int queue_size = 100;
     pnh.param("queue_size", queue_size, 100);
     pnh.param("use_camera_info", use_camera_info_, true);
-    pnh.param<std::string>("map_frame", map_frame_, "map");
-    pnh.param<std::string>("odom_frame", odom_frame_, "odom");
-    pnh.param<std::string>("base_frame", base_frame_, "base_link");
-    pnh.param<std::string>("camera_frame", camera_frame_, "");
-    pnh.param("publish_tf", publish_tf_, true);
-    pnh.param("publish_odom_tf", publish_odom_tf_, true);
-    pnh.param("publish_map_to_camera", map_to_camera_, false);
     pnh.param<std::string>("trajectory_path", trajectory_path_, "");
     pnh.param<std::string>("map_file", map_file_, "");
     pnh.param("localization_mode", localization_only_, false);
     pending_map_ = map_file_;
     pnh.param("map_publish_period", map_period_, 1.0);
     pnh.param("debug_image", debug_image_, true);
-    std::vector<double> b2c{0, 0, 0, -0.5, 0.5, -0.5, 0.5};
-    pnh.param("base_to_camera", b2c, b2c);
+    pnh.param("dense_map", dense_map_, false);
+    pnh.param("dense_map_publish_period", dense_period_, 2.0);
+    pnh.param<std::string>("octomap_path", octomap_path_, "");
+    DenseMapTopicsOptions dense_topics;
+    pnh.param("grid_min_height", dense_topics.grid_min_height, DenseMapTopicsOptions::kDefaultGridMinHeight);
+    pnh.param("grid_max_height", dense_topics.grid_max_height, DenseMapTopicsOptions::kDefaultGridMaxHeight);
     std::string settings_path, voc_path;
     pnh.param<std::string>("vocabulary", voc_path, "");
     try {
-      T_bc_ = poseFromParam(b2c, pnh.resolveName("base_to_camera"));
+      pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
       settings_ = loadSettings(pnh, &settings_path);
+      if (dense_map_) settings_.set("DenseMap.enabled", "1");
       camera_.configure(baseCamera(settings_), use_camera_info_);
       if (!voc_path.empty()) {
         Stopwatch sw;
@@ -127,7 +117,6 @@ class SlamNodelet : public nodelet::Nodelet {
       return;
     }
 
-    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("yolo_slam/pose", 10);
     path_pub_ = nh.advertise<nav_msgs::Path>("yolo_slam/path", 1, true);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("yolo_slam/map_points", 1, true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
@@ -135,8 +124,16 @@ class SlamNodelet : public nodelet::Nodelet {
     diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
-    if (debug_image_)
+    if (debug_image_ || dense_map_)
       rgb_sub_ = nh.subscribe("camera/rgb/image_color", 30, &SlamNodelet::onRgb, this);
+    if (dense_map_) {
+      depth_sub_ = nh.subscribe("camera/depth/image", 30, &SlamNodelet::onDepth, this);
+      dense_pub_.advertise(nh, dense_topics);
+      save_octomap_srv_ = nh.advertiseService("yolo_slam/save_octomap", &SlamNodelet::onSaveOctomap, this);
+      if (dense_period_ > 0)
+        dense_timer_ = nh.createWallTimer(::ros::WallDuration(dense_period_),
+                                          [this](const ::ros::WallTimerEvent&) { publishDenseMap(); });
+    }
     frame_sub_ = nh.subscribe("yolo_slam/keypoint_frame", queue_size, &SlamNodelet::onFrame, this,
                               ::ros::TransportHints().tcpNoDelay());
     reset_srv_ = nh.advertiseService("yolo_slam/reset", &SlamNodelet::onReset, this);
@@ -145,21 +142,12 @@ class SlamNodelet : public nodelet::Nodelet {
                                    this);
     save_map_srv_ = nh.advertiseService("yolo_slam/save_map", &SlamNodelet::onSaveMap, this);
     load_map_srv_ = nh.advertiseService("yolo_slam/load_map", &SlamNodelet::onLoadMap, this);
-    if (!publish_odom_tf_ && publish_tf_ && !map_to_camera_) {
-      tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
-      tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
-    }
     if (map_period_ > 0)
       map_timer_ = nh.createWallTimer(::ros::WallDuration(map_period_),
                                       [this](const ::ros::WallTimerEvent&) { publishMap(); });
     diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
                                      [this](const ::ros::WallTimerEvent&) { publishDiagnostics(); });
-    NODELET_INFO("Slam: tf %s, settings '%s'",
-                 !publish_tf_ ? "off"
-                 : map_to_camera_ ? (map_frame_ + " -> camera").c_str()
-                 : publish_odom_tf_ ? (map_frame_ + " -> " + odom_frame_ + " -> " + base_frame_).c_str()
-                                    : (map_frame_ + " -> " + odom_frame_ + " (odometry from tf)").c_str(),
-                 settings_path.c_str());
+    NODELET_INFO("Slam: tf %s, settings '%s'", pose_out_->describe().c_str(), settings_path.c_str());
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -173,7 +161,43 @@ class SlamNodelet : public nodelet::Nodelet {
   void onRgb(const sensor_msgs::ImageConstPtr& img) {
     std::lock_guard<std::mutex> lock(rgb_mutex_);
     recent_rgb_.push_back(img);
-    while (recent_rgb_.size() > 60) recent_rgb_.pop_front();
+    while (recent_rgb_.size() > kRecentImages) recent_rgb_.pop_front();
+  }
+
+  void onDepth(const sensor_msgs::ImageConstPtr& img) {
+    std::lock_guard<std::mutex> lock(rgb_mutex_);
+    recent_depth_.push_back(img);
+    while (recent_depth_.size() > kRecentImages) recent_depth_.pop_front();
+  }
+
+  // The newest of `images` with this stamp (null if gone). Caller holds rgb_mutex_.
+  static sensor_msgs::ImageConstPtr findByStamp(const std::deque<sensor_msgs::ImageConstPtr>& images,
+                                                const ::ros::Time& stamp) {
+    for (auto it = images.rbegin(); it != images.rend(); ++it)
+      if ((*it)->header.stamp == stamp) return *it;
+    return nullptr;
+  }
+
+  // A new keyframe's colour, depth and boxes to the dense map. Caller holds system_mutex_,
+  // right after the trackFeatures that made the keyframe. A missing image skips the keyframe.
+  void handDenseKeyFrame(const KeypointFrame& msg, const slam::TrackResult& res) {
+    sensor_msgs::ImageConstPtr rgb, depth;
+    {
+      std::lock_guard<std::mutex> lock(rgb_mutex_);
+      rgb = findByStamp(recent_rgb_, msg.header.stamp);
+      depth = findByStamp(recent_depth_, msg.depth_stamp);
+    }
+    try {
+      if (!depth) throw Error("its depth image is no longer buffered");
+      const cv::Mat bgr = rgb ? imageToBgr(*rgb, rgb_sub_.getTopic()) : cv::Mat();
+      cv::Mat image;
+      if (!bgr.empty() && camera().rgb_order) cv::cvtColor(bgr, image, cv::COLOR_BGR2RGB);
+      else image = bgr;
+      system_->addDenseKeyFrame(res, image, depthToMetres(*depth, depth_sub_.getTopic()), boxesFromMsg(msg.boxes));
+    } catch (const std::exception& e) {
+      NODELET_WARN_THROTTLE(5.0, "Slam: keyframe at %.3f left out of the dense map: %s", msg.header.stamp.toSec(),
+                            e.what());
+    }
   }
 
   CameraModel camera() { return camera_.get(info_sub_.getTopic()); }
@@ -205,7 +229,12 @@ class SlamNodelet : public nodelet::Nodelet {
     ++received_;
     if (!inStampOrder(msg->header.stamp.toSec())) return;
     slam::TrackResult res;
+    size_t corrections = 0;
     features::FeatureFrame frame;
+    if (!pose_out_->ready(msg->header.frame_id)) {
+      ++rejected_;
+      return;
+    }
     try {
       const CameraModel cam = camera();
       frame = fromMsg(*msg, cam);
@@ -217,7 +246,9 @@ class SlamNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(system_mutex_);
       if (!system_) startSystem(cam);
       res = system_->trackFeatures(frame);
+      corrections = system_->mapCorrections();
       track_ms_.push_back(sw.ms());
+      if (dense_map_ && res.keyframe_inserted) handDenseKeyFrame(*msg, res);
       if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
@@ -228,7 +259,7 @@ class SlamNodelet : public nodelet::Nodelet {
     last_state_ = res.state;
     if (res.state == slam::TrackingState::Ok) {
       ++tracked_;
-      publishPose(*msg, res.T_wc);
+      publishPose(*msg, res, corrections);
       recordLatency(msg->header.stamp);
     } else {
       ++not_tracked_;
@@ -246,63 +277,12 @@ class SlamNodelet : public nodelet::Nodelet {
     if (latency_ms_.size() > kLatencyWindow) latency_ms_.erase(latency_ms_.begin(), latency_ms_.begin() + kLatencyWindow / 2);
   }
 
-  // Camera pose in the SLAM world (first camera frame) -> base_link pose in the map frame
-  // (the first base_link frame, so the map is z-up when base_to_camera is right).
-  Pose mapFromWorld(const Pose& T_wc) const { return T_bc_ * T_wc * T_bc_.inverse(); }
-
-  void publishPose(const KeypointFrame& msg, const Pose& T_wc) {
-    const ::ros::Time stamp = msg.header.stamp;
-    std::string camera_frame = camera_frame_.empty() ? msg.header.frame_id : camera_frame_;
-    // TUM bags name frames "/openni_rgb_optical_frame"; tf2 frame ids may not start with '/'.
-    while (!camera_frame.empty() && camera_frame.front() == '/') camera_frame.erase(0, 1);
-    if (camera_frame.empty()) camera_frame = "camera_rgb_optical_frame";
-    // Pose of the published child frame in the map frame.
-    const Pose T_map_base = mapFromWorld(T_wc);
-    const Pose T_map_cam = T_bc_ * T_wc;
-    geometry_msgs::PoseStamped ps;
-    ps.header.stamp = stamp;
-    ps.header.frame_id = map_frame_;
-    ps.pose = poseToMsg(map_to_camera_ ? T_map_cam : T_map_base);
-    pose_pub_.publish(ps);
-    {
-      std::lock_guard<std::mutex> lock(path_mutex_);
-      path_.header = ps.header;
-      path_.poses.push_back(ps);
-      path_pub_.publish(path_);
-    }
-    if (!publish_tf_) return;
-    std::vector<geometry_msgs::TransformStamped> tfs;
-    auto add = [&](const std::string& parent, const std::string& child, const Pose& T) {
-      geometry_msgs::TransformStamped t;
-      t.header.stamp = stamp;
-      t.header.frame_id = parent;
-      t.child_frame_id = child;
-      t.transform = transformToMsg(T);
-      tfs.push_back(t);
-    };
-    if (map_to_camera_) {
-      add(map_frame_, camera_frame, T_map_cam);
-    } else if (publish_odom_tf_) {
-      // Visual odometry is the only motion source: odom follows the SLAM pose, map -> odom
-      // stays identity (loop closures show up as jumps of odom -> base_link).
-      add(map_frame_, odom_frame_, Pose::Identity());
-      add(odom_frame_, base_frame_, T_map_base);
-      add(base_frame_, camera_frame, T_bc_);
-    } else {
-      // Wheel/IMU odometry publishes odom -> base_link; we correct its drift with map -> odom.
-      try {
-        const auto t = tf_buffer_->lookupTransform(odom_frame_, base_frame_, stamp,
-                                                   ::ros::Duration(0.1));
-        const Pose T_odom_base = transformFromMsg(t.transform);
-        add(map_frame_, odom_frame_, T_map_base * T_odom_base.inverse());
-      } catch (const std::exception& e) {
-        NODELET_ERROR_THROTTLE(2.0, "Slam: no %s -> %s transform at %.3f (%s); map -> odom not "
-                               "published. Set ~publish_odom_tf true if nothing else publishes "
-                               "odometry", odom_frame_.c_str(), base_frame_.c_str(),
-                               stamp.toSec(), e.what());
-      }
-    }
-    if (!tfs.empty()) tf_broadcaster_.sendTransform(tfs);
+  void publishPose(const KeypointFrame& msg, const slam::TrackResult& res, size_t corrections) {
+    const geometry_msgs::PoseStamped ps = pose_out_->publish(msg.header.stamp, res.T_wc, res.inliers, corrections);
+    std::lock_guard<std::mutex> lock(path_mutex_);
+    path_.header = ps.header;
+    path_.poses.push_back(ps);
+    path_pub_.publish(path_);
   }
 
   void publishDebug(const KeypointFrame& msg, const slam::TrackResult& res) {
@@ -339,14 +319,7 @@ class SlamNodelet : public nodelet::Nodelet {
     cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3);
     cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
                 cv::Scalar(255, 255, 255), 1);
-    auto out = boost::make_shared<sensor_msgs::Image>();
-    out->header = msg.header;
-    out->width = img.cols;
-    out->height = img.rows;
-    out->encoding = sensor_msgs::image_encodings::BGR8;
-    out->step = img.cols * 3;
-    out->data.assign(img.data, img.data + img.total() * 3);
-    debug_pub_.publish(out);
+    debug_pub_.publish(cv_bridge::CvImage(msg.header, sensor_msgs::image_encodings::BGR8, img).toImageMsg());
   }
 
   void publishMap() {
@@ -362,29 +335,30 @@ class SlamNodelet : public nodelet::Nodelet {
     // Path rebuilt from the optimised trajectory (local BA and loop closing move old poses).
     if (!traj.empty()) {
       std::lock_guard<std::mutex> lock(path_mutex_);
-      path_.header.frame_id = map_frame_;
+      path_.header.frame_id = pose_out_->mapFrame();
       path_.header.stamp = ::ros::Time(traj.back().stamp);
       path_.poses.clear();
       path_.poses.reserve(traj.size());
       for (const auto& sp : traj) {
         geometry_msgs::PoseStamped ps;
-        ps.header.frame_id = map_frame_;
+        ps.header.frame_id = pose_out_->mapFrame();
         ps.header.stamp = ::ros::Time(sp.stamp);
-        ps.pose = poseToMsg(map_to_camera_ ? T_bc_ * sp.T_wc : mapFromWorld(sp.T_wc));
+        ps.pose = poseToMsg(pose_out_->publishedPose(sp.T_wc));
         path_.poses.push_back(ps);
       }
       path_pub_.publish(path_);
     }
 
     auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
-    cloud->header.frame_id = map_frame_;
+    const Pose T_map_world = pose_out_->worldInMap();
+    cloud->header.frame_id = pose_out_->mapFrame();
     cloud->header.stamp = now;
     sensor_msgs::PointCloud2Modifier mod(*cloud);
     mod.setPointCloud2FieldsByString(1, "xyz");
     mod.resize(snap.points.size());
     sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
     for (const auto& p : snap.points) {
-      const Eigen::Vector3d q = T_bc_ * p;
+      const Eigen::Vector3d q = T_map_world * p;
       *x = static_cast<float>(q.x());
       *y = static_cast<float>(q.y());
       *z = static_cast<float>(q.z());
@@ -394,7 +368,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
     auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
     visualization_msgs::Marker kf, edges;
-    kf.header.frame_id = edges.header.frame_id = map_frame_;
+    kf.header.frame_id = edges.header.frame_id = pose_out_->mapFrame();
     kf.header.stamp = edges.header.stamp = now;
     kf.ns = "keyframes";
     edges.ns = "covisibility";
@@ -419,7 +393,7 @@ class SlamNodelet : public nodelet::Nodelet {
     const Eigen::Vector3d corners[4] = {{-w, -h, d}, {w, -h, d}, {w, h, d}, {-w, h, d}};
     std::vector<Eigen::Vector3d> centres;
     for (const auto& k : snap.keyframes) {
-      const Pose T = T_bc_ * k.T_wc;
+      const Pose T = T_map_world * k.T_wc;
       const Eigen::Vector3d o = T.translation();
       centres.push_back(o);
       for (int i = 0; i < 4; ++i) {
@@ -441,6 +415,12 @@ class SlamNodelet : public nodelet::Nodelet {
     markers->markers.push_back(kf);
     markers->markers.push_back(edges);
     marker_pub_.publish(markers);
+  }
+
+  void publishDenseMap() {
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    const mapping::DenseMapper* dense = system_ ? system_->denseMap() : nullptr;
+    if (dense) dense_pub_.publish(*dense, pose_out_->worldInMap(), pose_out_->mapFrame(), ::ros::Time::now());
   }
 
   void publishDiagnostics() {
@@ -617,6 +597,40 @@ class SlamNodelet : public nodelet::Nodelet {
     return true;
   }
 
+  // yolo_slam/save_octomap (yolo_slam/MapFile: path, empty = ~octomap_path): the dense map as an
+  // OctoMap .bt in the SLAM world frame; keyframes = keyframes integrated, map_points = voxels.
+  bool onSaveOctomap(yolo_slam::MapFile::Request& req, yolo_slam::MapFile::Response& res) {
+    const std::string path = req.path.empty() ? octomap_path_ : req.path;
+    try {
+      if (path.empty()) throw Error("no path in the request and no ~octomap_path parameter");
+      std::lock_guard<std::mutex> lock(system_mutex_);
+      const mapping::DenseMapper* dense = system_ ? system_->denseMap() : nullptr;
+      if (!dense) throw Error("no dense map yet: the first frame has not arrived");
+      dense->writeOctomap(path);
+      const mapping::DenseMapStats st = dense->stats();
+      res.success = true;
+      res.message = path;
+      res.keyframes = static_cast<uint32_t>(st.keyframes);
+      res.map_points = static_cast<uint32_t>(st.voxels);
+      NODELET_INFO("Slam: octomap saved to %s (%zu voxels)", path.c_str(), st.voxels);
+    } catch (const std::exception& e) {
+      fail(res, "save_octomap failed", e);
+    }
+    return true;
+  }
+
+  // ~octomap_path after the System's shutdown (the final poses). Caller holds system_mutex_.
+  void saveOctomapAtShutdown() {
+    const mapping::DenseMapper* dense = system_->denseMap();
+    if (!dense || octomap_path_.empty()) return;
+    try {
+      dense->writeOctomap(octomap_path_);
+      ROS_INFO("Slam: wrote the dense map to %s at shutdown", octomap_path_.c_str());
+    } catch (const std::exception& e) {
+      ROS_ERROR("Slam: cannot write the dense map at shutdown: %s", e.what());
+    }
+  }
+
   bool onLocalization(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
     std::lock_guard<std::mutex> lock(system_mutex_);
     localization_only_ = req.data;
@@ -628,12 +642,11 @@ class SlamNodelet : public nodelet::Nodelet {
   }
 
   // Parameters (const after onInit).
-  bool use_camera_info_ = true, publish_tf_ = true, publish_odom_tf_ = true;
+  bool use_camera_info_ = true;
   ErrorThrottle throttle_;
-  bool map_to_camera_ = false, debug_image_ = true;
-  double map_period_ = 1.0;
-  std::string map_frame_, odom_frame_, base_frame_, camera_frame_, trajectory_path_, map_file_;
-  Pose T_bc_ = Pose::Identity();  // camera pose in base_link
+  bool debug_image_ = true, dense_map_ = false;
+  double map_period_ = 1.0, dense_period_ = 2.0;
+  std::string trajectory_path_, map_file_, octomap_path_;
   Config settings_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
@@ -650,8 +663,11 @@ class SlamNodelet : public nodelet::Nodelet {
   std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
   nav_msgs::Path path_;
 
-  std::mutex rgb_mutex_;  // guards recent_rgb_ (colour callback vs frame callback)
-  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_;
+  // Guards recent_rgb_ and recent_depth_ (image callbacks vs frame callback); taken alone or
+  // after system_mutex_.
+  static constexpr size_t kRecentImages = 60;
+  std::mutex rgb_mutex_;
+  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_, recent_depth_;
 
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
@@ -666,13 +682,15 @@ class SlamNodelet : public nodelet::Nodelet {
   std::vector<double> latency_ms_;
   std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
 
-  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_;
-  ::ros::Publisher pose_pub_, path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
-  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_;
-  ::ros::WallTimer map_timer_, diag_timer_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
-  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_, depth_sub_;
+  // Pose, odometry and tf. Used by the frame callback; the map timer reads its frames and
+  // mount only once system_ exists, i.e. after the frame callback resolved the mount (the
+  // mount is written once, before system_ is created under system_mutex_).
+  std::unique_ptr<PoseOutput> pose_out_;
+  ::ros::Publisher path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
+  ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_, save_octomap_srv_;
+  ::ros::WallTimer map_timer_, diag_timer_, dense_timer_;
+  DenseMapPublisher dense_pub_;
 };
 
 }  // namespace ros1

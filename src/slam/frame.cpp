@@ -149,5 +149,19 @@ void computeBow(const vocabulary::Vocabulary* voc, Frame& F) {
   voc->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
 }
 
+void Frame::releaseFeatures() {
+  N = 0;
+  std::vector<cv::KeyPoint>().swap(kps);
+  descriptors.release();
+  std::vector<float>().swap(depth);
+  std::vector<float>().swap(right_u);
+  std::vector<uint8_t>().swap(dynamic);
+  std::vector<int8_t>().swap(motion);
+  std::vector<MapPointPtr>().swap(points);
+  std::vector<bool>().swap(outlier);
+  bow = BowData();
+  std::vector<std::vector<uint32_t>>().swap(grid_);
+}
+
 }  // namespace slam
 }  // namespace yolo_slam

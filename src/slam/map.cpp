@@ -130,6 +130,7 @@ void Map::eraseKeyFrame(const KeyFramePtr& kf) {
   kf->bad = true;
   keyframes_.erase(kf);
   if (kfdb_) kfdb_->erase(kf->id);
+  kf->f.releaseFeatures();
 }
 
 std::vector<KeyFramePtr> Map::keyframes() const {

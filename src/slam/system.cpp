@@ -42,6 +42,7 @@ SystemOptions SystemOptions::load(const Config& cfg) {
   o.orb = features::OrbOptions::load(cfg);
   o.screening = screening::ScreeningOptions::load(cfg);
   o.slam = SlamOptions::load(cfg);
+  o.dense = mapping::DenseMapOptions::load(cfg);
   o.sequential = cfg.getBool("System.sequential", o.sequential);
   checkInitialisable(o, configName(cfg));
   return o;
@@ -75,8 +76,17 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     mapper_->setLoopClosing(loop_closer_.get());
   }
   tracker_ = std::make_unique<Tracking>(cam_, opt_.tracking, *map_, mapper_.get(), voc_, pyr);
+  if (options.dense.enabled) {
+    // Poses change when a loop is closed or a global BA is written back.
+    auto version = [this] {
+      return loop_closer_ ? static_cast<long>(loop_closer_->loopsClosed() + loop_closer_->globalBundleAdjustments()) : 0L;
+    };
+    dense_ = std::make_unique<mapping::DenseMapper>(cam_, options.dense, screening_options_,
+                                                    run_mode_ == RunMode::Threaded, version);
+  }
   mapper_->start();
   if (loop_closer_) loop_closer_->start();
+  if (dense_) dense_->start();
 }
 
 System::~System() { shutdown(); }
@@ -94,6 +104,7 @@ void System::shutdown() {
     loop_closer_->stop();
   }
   mapper_->stop();
+  if (dense_) dense_->stop();
 }
 
 namespace {
@@ -154,9 +165,51 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   {
     std::lock_guard<std::mutex> lk(last_frame_mutex_);
     last_frame_ = fe.frame;
-    last_boxes_ = std::move(fe.boxes);
+    last_boxes_ = fe.boxes;
   }
-  return trackFeatures(fe.frame);
+  const TrackResult res = trackFeatures(fe.frame);
+  addDenseKeyFrame(res, image, usableDepth(depth_m, image, stamp), fe.boxes);
+  return res;
+}
+
+namespace {
+// T_wc of a keyframe now: through the spanning tree when it was culled, nullopt when the
+// keyframe is gone (map reset or replaced).
+mapping::PoseGetter keyFramePose(const KeyFramePtr& kf, Map& map) {
+  std::weak_ptr<KeyFrame> weak = kf;
+  return [weak, &map]() -> std::optional<Pose> {
+    const KeyFramePtr k = weak.lock();
+    if (!k) return std::nullopt;
+    std::lock_guard<std::mutex> ml(map.update_mutex);
+    Pose T_kr;
+    const KeyFramePtr live = liveAncestor(k, &T_kr);
+    if (!live) return std::nullopt;
+    return (T_kr * live->Tcw()).inverse();
+  };
+}
+}  // namespace
+
+void System::addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
+                              const detection::Boxes& boxes) {
+  if (!dense_) return;
+  if (res.keyframe_inserted && !depth_m.empty()) {
+    mapping::DenseKeyFrame d;
+    {
+      std::lock_guard<std::mutex> tl(track_mutex_);
+      std::lock_guard<std::mutex> ml(map_->update_mutex);
+      const KeyFramePtr& kf = tracker_->lastKeyFrame();
+      if (!kf) return;
+      d.id = kf->id;
+      d.stamp = kf->f.stamp;
+      d.pose = keyFramePose(kf, *map_);
+    }
+    d.image = image.clone();
+    d.depth_m = depth_m.clone();
+    d.boxes = boxes;
+    dense_->insert(std::move(d));
+  }
+  // Sequential: also after frames without a keyframe, so a loop's rebuild is not put off.
+  if (run_mode_ == RunMode::Sequential) dense_->processQueued();
 }
 
 TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
@@ -225,6 +278,7 @@ void System::resetInternal(bool keep_trajectory) {
     }
     map_->clear();
   }
+  if (dense_) dense_->clear();
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     ++stats_.resets;
@@ -258,6 +312,8 @@ MapFileInfo System::loadMap(const std::string& path) {
     tracker_->startInLoadedMap();
     map_->adopt(*loaded);
   }
+  ++maps_loaded_;
+  if (dense_) dense_->clear();
   resumeBackEnd();
   return info;
 }
@@ -375,6 +431,17 @@ SystemStats System::stats() const {
   s.loops_closed = loops;
   s.global_bas = gbas;
   return s;
+}
+
+size_t System::mapCorrections() const {
+  size_t n = 0;
+  {
+    std::lock_guard<std::mutex> tl(track_mutex_);
+    n += tracker_->relocalizations() + maps_loaded_;
+  }
+  if (loop_closer_) n += loop_closer_->loopsClosed() + loop_closer_->globalBundleAdjustments();
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  return n + stats_.resets;
 }
 
 BoxCounts& BoxCounts::operator+=(const BoxCounts& o) {

@@ -248,6 +248,7 @@ bool Tracking::initialize(Frame& F) {
     createDepthPoint(kf, F, i);
   }
   if (mapper_) mapper_->insertKeyFrame(kf);
+  last_kf_ = kf;
   ref_kf_ = kf;
   last_kf_frame_id_ = F.id;
   local_kfs_ = {kf};
@@ -643,6 +644,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
     if (mp && !mp->bad) mp->dynamic = true;
   dynamic_hits_.clear();
   mapper_->insertKeyFrame(kf);
+  last_kf_ = kf;
   last_kf_frame_id_ = F.id;
 }
 
@@ -691,6 +693,7 @@ void Tracking::resetKeepTrajectory() {
   has_last_ = false;
   last_ = Frame();
   ref_kf_.reset();
+  last_kf_.reset();
   last_ref_.reset();
   last_kf_frame_id_ = -1;
   has_velocity_ = false;

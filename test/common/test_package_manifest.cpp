@@ -80,14 +80,15 @@ std::string concatSources(std::initializer_list<const char*> dirs, std::initiali
 const std::map<std::string, std::string> kIncludeKey = {
     {"ros", "roscpp"}, {"opencv2", "libopencv-dev"}, {"Eigen", "eigen"},
     {"ceres", "libceres-dev"}, {"openni2", "libopenni2-dev"}, {"gtest", "gtest"},
-    {"nlohmann", "nlohmann-json-dev"}, {"cereal", "libcereal-dev"}};
+    {"nlohmann", "nlohmann-json-dev"}, {"cereal", "libcereal-dev"},
+    {"octomap", "liboctomap-dev"}};
 // Include prefixes that need no key: the C library and the project itself.
 const std::set<std::string> kIncludeNoKey = {"sys", "yolo_slam"};
 // Python modules imported by scripts and benchmarks that need a key; the standard library needs none.
 const std::map<std::string, std::string> kPythonKey = {
     {"rospy", "rospy"}, {"rosbag", "rosbag"}, {"tf2_msgs", "tf2_msgs"}, {"cv2", "python3-opencv"},
     {"numpy", "python3-numpy"}, {"sensor_msgs", "sensor_msgs"}, {"geometry_msgs", "geometry_msgs"},
-    {"diagnostic_msgs", "diagnostic_msgs"}};
+    {"diagnostic_msgs", "diagnostic_msgs"}, {"nav_msgs", "nav_msgs"}, {"tf2_ros", "tf2_ros"}};
 const std::set<std::string> kPythonStdlib = {"argparse", "collections", "json", "math", "os", "re",
                                              "statistics", "sys", "xml", "subprocess", "time", "glob",
                                              "shutil", "struct", "tempfile", "itertools", "functools", "signal"};

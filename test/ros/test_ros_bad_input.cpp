@@ -160,6 +160,16 @@ TEST_F(BadInput, ScreeningRejectsWrongDepthEncodingAndEmptyDepth) {
       },
       [] { return logged("empty image on /camera/depth/image"); }, 15))
       << watch_->dump();
+  // Unregistered depth (the depth camera's own frame) is refused, not screened pixel for pixel.
+  EXPECT_TRUE(sendUntil(
+      [](const ros::Time& t) {
+        rgb_pub_.publish(toImage(rgb_, enc::BGR8, t));
+        auto d = toImage(depth_, enc::TYPE_32FC1, t);
+        d->header.frame_id = "camera_depth_optical_frame";
+        depth_pub_.publish(d);
+      },
+      [] { return logged("depth is not registered to colour"); }, 15))
+      << watch_->dump();
 }
 
 TEST_F(BadInput, SlamRejectsInconsistentKeypointFrames) {

@@ -123,9 +123,20 @@ TEST(SlamMap, EraseKeyFrameKeepsGraphConsistent) {
   KeyFramePtr victim = fx.kfs[2];
   std::weak_ptr<KeyFrame> weak = victim;
   const size_t before = fx.map.numKeyFrames();
+  const Pose T_cw = victim->Tcw();
+  ASSERT_GT(victim->f.N, 0);
   fx.map.eraseKeyFrame(victim);
   EXPECT_TRUE(victim->bad);
   EXPECT_EQ(fx.map.numKeyFrames(), before - 1);
+  // The trajectory keeps erased keyframes as anchors of relative poses: their features are freed,
+  // the pose and the link to the parent stay.
+  EXPECT_EQ(victim->f.N, 0);
+  EXPECT_TRUE(victim->f.kps.empty());
+  EXPECT_TRUE(victim->f.descriptors.empty());
+  EXPECT_TRUE(victim->f.points.empty());
+  EXPECT_TRUE(victim->f.featuresInArea(320, 240, 100).empty());
+  EXPECT_TRUE(victim->Tcw().isApprox(T_cw));
+  EXPECT_TRUE((victim->T_cp * victim->parent->Tcw()).isApprox(T_cw, 1e-9));
   for (const auto& kf : fx.map.keyframes()) EXPECT_EQ(kf->weight(victim), 0);
   expectConsistent(fx.map);
   // Every remaining non-origin keyframe still reaches the origin through the tree.

@@ -228,7 +228,9 @@ TEST_F(SlamMapFile, AnotherVocabularyCameraOrPyramidIsRefused) {
 TEST_F(SlamMapFile, LocalizationRelocalisesInALoadedMap) {
   slam::System sys(generator().camera(), testOptions(), vocab());
   sys.setLocalizationOnly(true);  // before the first frame and before the load
+  const size_t corrections_before = sys.mapCorrections();
   sys.loadMap(file());
+  EXPECT_GT(sys.mapCorrections(), corrections_before) << "a loaded map must count as a map correction (odom)";
   const Pose T_w0 = generator().frame(0).T_wc;  // the map's world frame is its first camera
   int tracked = 0;
   for (size_t i = kLaterFirst; i <= kLaterLast; ++i) {
@@ -243,6 +245,9 @@ TEST_F(SlamMapFile, LocalizationRelocalisesInALoadedMap) {
   std::printf("localization in the loaded map: %d of %zu frames tracked, %zu relocalisations\n", tracked,
               kLaterLast - kLaterFirst + 1, s.relocalizations);
   EXPECT_GE(s.relocalizations, 1u);
+  EXPECT_GE(sys.mapCorrections(), 1 + s.relocalizations);
+  sys.reset();
+  EXPECT_GE(sys.mapCorrections(), 2 + s.relocalizations);
   EXPECT_GE(tracked, static_cast<int>(kLaterLast - kLaterFirst) - 2);
   EXPECT_EQ(s.keyframes, info_.keyframes) << "localization mode added keyframes";
   EXPECT_EQ(s.map_points, info_.map_points) << "localization mode changed the map";

@@ -132,6 +132,18 @@ LoopClosing.poseGraphIterations: 25
 LoopClosing.globalBA: 0
 LoopClosing.globalBAIterations: 8
 System.sequential: 1
+DenseMap.enabled: 1
+DenseMap.resolution: 0.125
+DenseMap.maxRange: 3.5
+DenseMap.pixelStride: 3
+DenseMap.cloudResolution: 0.03125
+DenseMap.probHit: 0.75
+DenseMap.probMiss: 0.375
+DenseMap.queueSize: 5
+DenseMap.finalRebuild: 0
+DenseMap.maskPeople: 0
+DenseMap.maskMargin: 9
+DenseMap.maskSampleStride: 2
 )";
 
 std::set<std::string> topLevelKeys(const cv::FileStorage& fs) {
@@ -190,6 +202,12 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(1500, 1.25, 6, 18, 6));
   EXPECT_DOUBLE_EQ(orb.dynamic_boost_max, 1.5);
   EXPECT_TRUE(sys.sequential);
+  const mapping::DenseMapOptions& dm = sys.dense;
+  EXPECT_EQ(std::tie(dm.enabled, dm.resolution_m, dm.max_range_m, dm.pixel_stride, dm.cloud_resolution_m),
+            std::make_tuple(true, 0.125, 3.5, 3, 0.03125));
+  EXPECT_EQ(std::tie(dm.prob_hit, dm.prob_miss, dm.queue_size, dm.final_rebuild, dm.mask_people, dm.mask.margin_px,
+                     dm.mask.sample_stride_px),
+            std::make_tuple(0.75, 0.375, 5, false, false, 9, 2));
 
   const detection::DetectorOptions d = detection::DetectorOptions::load(cfg);
   EXPECT_EQ(d.model, "/tmp/ys_model");
@@ -308,6 +326,12 @@ TEST(Options, RejectionsNameFileKeyRuleAndValue) {
             "bad.yaml: key 'Screening.varianceThreshold' must be > 0 (got 0)");
   EXPECT_EQ(systemRejection("Screening.clusterMinFraction", "0"),
             "bad.yaml: key 'Screening.clusterMinFraction' must be in (0, 1] (got 0)");
+  EXPECT_EQ(systemRejection("DenseMap.resolution", "0"),
+            "bad.yaml: key 'DenseMap.resolution' must be > 0 (got 0)");
+  EXPECT_EQ(systemRejection("DenseMap.probMiss", "0.6"),
+            "bad.yaml: key 'DenseMap.probMiss' must be in (0, 0.5) (got 0.6)");
+  EXPECT_EQ(systemRejection("DenseMap.pixelStride", "0"),
+            "bad.yaml: key 'DenseMap.pixelStride' must be >= 1 (got 0)");
   EXPECT_EQ(systemRejection("Screening.mode", "sometimes"),
             "bad.yaml: key 'Screening.mode' must be one of off, detect, geometry, detect+geometry "
             "(got 'sometimes')");

@@ -21,6 +21,10 @@ class Stopwatch {
   Clock::time_point start_;
 };
 
+// CPU time the calling thread has used, in milliseconds (CLOCK_THREAD_CPUTIME_ID): the work of
+// a stage apart from the waiting a loaded machine adds to its wall time.
+double threadCpuMs();
+
 struct Summary {
   size_t count = 0;
   double mean = 0, median = 0, p95 = 0, min = 0, max = 0;

@@ -19,5 +19,11 @@ Trajectory readTrajectory(const std::string& path);
 // with qw >= 0. Throws yolo_slam::Error naming the file when it cannot be written.
 void writeTrajectory(const std::string& path, const Trajectory& traj);
 
+// The comment line a written trajectory starts with, newline included.
+extern const char* const kTumTrajectoryHeader;
+// One pose as writeTrajectory writes it, newline included (also the runner's incremental
+// CameraTrajectory.partial.txt, so both files read the same way).
+std::string formatTumPose(const StampedPose& p);
+
 }  // namespace io
 }  // namespace yolo_slam

@@ -68,6 +68,10 @@ class Frame {
   std::shared_ptr<const ScalePyramid> pyramid;
 
   void setPose(const Pose& T) { T_cw = T; }
+  // Frees the keypoints, descriptors, BoW and grid (N becomes 0), keeping pose and camera. For
+  // erased keyframes: the trajectory still refers to them for its relative poses, and without
+  // this each would keep its features (about 250 KB) for the rest of the run.
+  void releaseFeatures();
   Pose Twc() const { return T_cw.inverse(); }
   Eigen::Vector3d cameraCenter() const { return T_cw.inverse().translation(); }
 

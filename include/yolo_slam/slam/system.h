@@ -9,6 +9,7 @@
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/frontend/front_end.h"
+#include "yolo_slam/mapping/dense_mapper.h"
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/map_file.h"
 #include "yolo_slam/slam/options.h"
@@ -85,6 +86,7 @@ struct SystemOptions {
   features::OrbOptions orb;              // ORBextractor.*
   screening::ScreeningOptions screening; // Screening.*
   SlamOptions slam;                      // Tracking.*, LocalMapping.*, LoopClosing.*
+  mapping::DenseMapOptions dense;        // DenseMap.*: the dense static map (off by default)
   // System.sequential: local mapping, loop closing and the global BA after a loop run in the
   // caller's thread right after each tracked frame, not in their own threads, so identical
   // input gives bit-identical output (slower: the caller waits for the back end).
@@ -115,6 +117,16 @@ class System {
                         const detection::Boxes& boxes, bool detector_ran = true);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
   TrackResult trackFeatures(const features::FeatureFrame& frame);
+  // Dense map (DenseMap.enabled): hands the keyframe the last trackFeatures made, with the
+  // frame's colour image, depth (CV_32F metres) and person boxes, to the dense mapper (copies
+  // them; the mapper masks and integrates in its own thread, or here when sequential). Call
+  // right after the trackFeatures whose result it gets; trackRgbd does. Hands nothing over
+  // unless res.keyframe_inserted and the dense map is on; when sequential, it integrates here
+  // (and rebuilds after a loop) on every call.
+  void addDenseKeyFrame(const TrackResult& res, const cv::Mat& image, const cv::Mat& depth_m,
+                        const detection::Boxes& boxes);
+  // The dense mapper, null when DenseMap.enabled is 0. Complete (final poses) after shutdown().
+  const mapping::DenseMapper* denseMap() const { return dense_.get(); }
 
   void reset();
   void setLocalizationOnly(bool on);
@@ -147,6 +159,10 @@ class System {
   // Timing of the detector, measured by the caller that runs it (reported in the stats).
   void recordDetectionTime(double ms);
   TrackingState state() const;
+  // Grows whenever the map's frame may have jumped under the camera: a reset, a map load, a
+  // relocalisation, a loop closure or a global BA written back. Poses of two frames between
+  // which it did not change differ by tracked motion only (slam::ContinuousOdometry).
+  size_t mapCorrections() const;
   // Copy of the last frame trackRgbd extracted and screened (dynamic flags as set by the
   // screener), e.g. for screening metrics against ground truth; empty before the first frame.
   features::FeatureFrame lastFrame() const;
@@ -187,6 +203,9 @@ class System {
   std::unique_ptr<LocalMapping> mapper_;
   std::unique_ptr<LoopClosing> loop_closer_;   // null without vocabulary or when disabled
   std::unique_ptr<Tracking> tracker_;
+  // Declared after map_ (destroyed first: its pose getters read the map's keyframes); stopped
+  // in shutdown() after local mapping and loop closing, so its final rebuild sees final poses.
+  std::unique_ptr<mapping::DenseMapper> dense_;
 
   // Serialises the tracking entry points (trackRgbd/trackFeatures/reset/setLocalizationOnly)
   // against each other; in sequential mode also the local mapping and loop closing they run
@@ -197,6 +216,7 @@ class System {
   mutable std::mutex stats_mutex_;
   SystemStats stats_;
   bool shut_down_ = false;
+  size_t maps_loaded_ = 0;  // guarded by track_mutex_
   std::atomic<bool> localization_only_{false};
   // Guards last_frame_ (taken alone, never while holding another of the mutexes above).
   mutable std::mutex last_frame_mutex_;

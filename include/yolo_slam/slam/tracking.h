@@ -53,6 +53,8 @@ class Tracking {
   void setLocalizationOnly(bool on) { localization_only_ = on; }
   bool localizationOnly() const { return localization_only_; }
   TrackingState state() const { return state_; }
+  // The keyframe the last track() made (when its TrackResult says keyframe_inserted).
+  const KeyFramePtr& lastKeyFrame() const { return last_kf_; }
 
   // Caller holds map.update_mutex.
   Trajectory trajectory() const;
@@ -120,6 +122,7 @@ class Tracking {
   Frame last_;
   bool has_last_ = false;
   KeyFramePtr ref_kf_;          // reference keyframe of the current frame
+  KeyFramePtr last_kf_;         // the newest keyframe made
   long last_kf_frame_id_ = -1;
   Pose T_lr_ = Pose::Identity();   // last frame relative to its reference keyframe
   KeyFramePtr last_ref_;
