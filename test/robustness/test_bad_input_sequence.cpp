@@ -43,6 +43,7 @@ TEST_F(BadSequence, SaturatedDepthIsNoDepthAndNamedPerFile) {
   EXPECT_TRUE(contains(r.err, firstDepthFile(seq) + ": every reading is 65535")) << r;
   EXPECT_TRUE(contains(r.err, "(tracked without depth)")) << r;
   EXPECT_EQ(dataLines(joinPath(outDir(), "CameraTrajectory.txt")), 0u) << "no pose from no depth\n" << r;
+  EXPECT_NE(r.exit_code, 0) << "a run that tracked nothing does not exit 0\n" << r;
 }
 
 TEST_F(BadSequence, DepthBeyondTheRangeIsNoDepth) {
@@ -50,6 +51,7 @@ TEST_F(BadSequence, DepthBeyondTheRangeIsNoDepth) {
   fillDepth(seq, 60000);  // 12 m with factor 5000: beyond the default DepthMaxRange of 10 m
   const Outcome r = runSlam(seq);
   ASSERT_TRUE(r.exited()) << r;
+  EXPECT_NE(r.exit_code, 0) << r;
   EXPECT_EQ(dataLines(joinPath(outDir(), "CameraTrajectory.txt")), 0u) << r;
   // DepthMaxRange is a setting: a range that covers 12 m lets the same frames track.
   const Outcome wide = runSlam(seq, {"--set", "DepthMaxRange=15"});
