@@ -80,7 +80,9 @@ class FuzzReaders : public ::testing::Test {
     // The mutations must reach the checks: some mutants are refused, and (but for a checksummed
     // format) not all, so that the parser behind the first checks is reached too.
     EXPECT_GT(refused, 0) << target;
-    if (!checksummed) EXPECT_LT(refused, n) << target;
+    if (!checksummed) {
+      EXPECT_LT(refused, n) << target;
+    }
   }
 
   std::string path(const std::string& name) const { return joinPath(dir_, name); }
