@@ -206,5 +206,26 @@ bool waitFor(Pred ready, int timeout_s = kRunTimeoutS) {
   return true;
 }
 
+// A suite of runner tests over one sequence in its own temporary tree, made once per suite;
+// every test skips when yolo_slam_run is not built. `Suite` names the tree (kTree) and makes
+// the sequence in it (makeSequence), both public.
+template <class Suite>
+class RunSuite : public ::testing::Test {
+ protected:
+  static inline TempTree* tree_ = nullptr;
+  static inline std::string seq_;
+  static void SetUpTestSuite() {
+    tree_ = new TempTree(Suite::kTree);
+    seq_ = Suite::makeSequence(*tree_);
+  }
+  static void TearDownTestSuite() {
+    delete tree_;
+    tree_ = nullptr;
+  }
+  void SetUp() override {
+    if (!fileExists(tool())) GTEST_SKIP() << tool() << " not built (make yolo_slam_run)";
+  }
+};
+
 }  // namespace robustness
 }  // namespace yolo_slam

@@ -15,21 +15,14 @@ constexpr int kExitTooFewTracked = 3;
 constexpr int kGapFrame = 10;
 constexpr double kGapS = 1000.0;
 
-class RunExitCodes : public ::testing::Test {
+class RunExitCodes : public RunSuite<RunExitCodes> {
+ public:
+  static constexpr const char* kTree = "run_exit_codes";
+  static std::string makeSequence(TempTree& tree) {
+    return tree.generate("seq");
+  }
+
  protected:
-  static TempTree* tree_;
-  static std::string seq_;
-  static void SetUpTestSuite() {
-    tree_ = new TempTree("run_exit_codes");
-    seq_ = tree_->generate("seq");
-  }
-  static void TearDownTestSuite() {
-    delete tree_;
-    tree_ = nullptr;
-  }
-  void SetUp() override {
-    if (!fileExists(tool())) GTEST_SKIP() << tool() << " not built (make yolo_slam_run)";
-  }
 
   // Every image of `sub` (rgb or depth) in a copy of the sequence replaced by `make()`.
   template <class Make>
@@ -55,8 +48,6 @@ class RunExitCodes : public ::testing::Test {
     EXPECT_EQ(js["tracked"], 0) << js.dump();
   }
 };
-TempTree* RunExitCodes::tree_ = nullptr;
-std::string RunExitCodes::seq_;
 
 // The sequence with every stamp from frame kGapFrame on moved kGapS later.
 std::string withStampGap(const TempTree& tree, const std::string& seq) {

@@ -10,21 +10,14 @@ using namespace yolo_slam::robustness;
 
 namespace {
 
-class RunOutputs : public ::testing::Test {
+class RunOutputs : public RunSuite<RunOutputs> {
+ public:
+  static constexpr const char* kTree = "run_outputs";
+  static std::string makeSequence(TempTree& tree) {
+    return tree.generate("seq");
+  }
+
  protected:
-  static TempTree* tree_;
-  static std::string seq_;
-  static void SetUpTestSuite() {
-    tree_ = new TempTree("run_outputs");
-    seq_ = tree_->generate("seq");
-  }
-  static void TearDownTestSuite() {
-    delete tree_;
-    tree_ = nullptr;
-  }
-  void SetUp() override {
-    if (!fileExists(tool())) GTEST_SKIP() << tool() << " not built (make yolo_slam_run)";
-  }
   // Runs and expects a refusal before the first frame: exit 1, one error line naming `path`.
   static void expectRefusedBeforeWork(const std::vector<std::string>& args, const std::string& path,
                                       const std::string& log) {
@@ -35,8 +28,6 @@ class RunOutputs : public ::testing::Test {
     EXPECT_EQ(err.find("yolo_slam_run: "), std::string::npos) << err;
   }
 };
-TempTree* RunOutputs::tree_ = nullptr;
-std::string RunOutputs::seq_;
 
 std::vector<std::string> filesIn(const std::string& dir) {
   std::vector<std::string> names;

@@ -20,25 +20,18 @@ constexpr double kSlowDown = 4.0;
 // Between two signals (the reproduction: a second Ctrl-C 50 ms after the first).
 constexpr auto kSecondSignalDelay = std::chrono::milliseconds(50);
 
-class RunSignals : public ::testing::Test {
- protected:
-  static TempTree* tree_;
-  static std::string seq_;
-  static void SetUpTestSuite() {
-    tree_ = new TempTree("run_signals");
-    const std::string recorded = tree_->generate("recorded");
+class RunSignals : public RunSuite<RunSignals> {
+ public:
+  static constexpr const char* kTree = "run_signals";
+  static std::string makeSequence(TempTree& tree) {
+    const std::string recorded = tree.generate("recorded");
     std::ifstream first(joinPath(recorded, "associations.txt"));
     double t0 = 0;
     first >> t0;
-    seq_ = withStamps(*tree_, recorded, "seq", [t0](int, double t) { return t0 + (t - t0) * kSlowDown; });
+    return withStamps(tree, recorded, "seq", [t0](int, double t) { return t0 + (t - t0) * kSlowDown; });
   }
-  static void TearDownTestSuite() {
-    delete tree_;
-    tree_ = nullptr;
-  }
-  void SetUp() override {
-    if (!fileExists(tool())) GTEST_SKIP() << tool() << " not built (make yolo_slam_run)";
-  }
+
+ protected:
   static std::string partialOf(const std::string& out) { return joinPath(out, "CameraTrajectory.partial.txt"); }
 
   // Starts a --realtime run (a few seconds of stamps) and waits until poses are on disk.
@@ -68,8 +61,6 @@ class RunSignals : public ::testing::Test {
     EXPECT_EQ(js["trajectory_poses"], poseLines(traj)) << js.dump();
   }
 };
-TempTree* RunSignals::tree_ = nullptr;
-std::string RunSignals::seq_;
 
 }  // namespace
 

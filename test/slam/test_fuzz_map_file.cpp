@@ -4,6 +4,7 @@
 // their payload (size and FNV-1a checksum recomputed), so that the payload parser and the map
 // rebuild see the corruption. Each must load or be refused with yolo_slam::Error, never crash,
 // throw anything else or allocate beyond the file. YS_FUZZ_ITERATIONS mutants per mode.
+#include "support/bytes.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/sim/generator.h"
@@ -31,16 +32,8 @@ constexpr size_t kFrames = 12;
 constexpr size_t kSizeOffset = 13, kChecksumOffset = 21, kHeaderBytes = 29;
 constexpr uint64_t kFnvBasis = 1469598103934665603ull, kFnvPrime = 1099511628211ull;
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-void writeBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-}
+using ::test_support::readBytes;
+using ::test_support::writeBytes;
 
 // `header` (the original's) with the size and checksum of `payload`.
 std::string resealed(const std::string& header, const std::string& payload) {

@@ -3,6 +3,7 @@
 // corrupted, another version, vocabulary, camera or ORB pyramid) are refused with an error
 // naming the file while the running map stays as it was, and a new System in
 // localization mode relocalises in a loaded map and tracks later frames of the run.
+#include "support/bytes.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/sim/generator.h"
@@ -54,20 +55,12 @@ sim::SequenceGenerator& generator() {
 }
 
 std::shared_ptr<const vocabulary::Vocabulary> vocab() {
-  static auto voc = test_support::shippedVocabulary();
+  static auto voc = yolo_slam::test_support::shippedVocabulary();
   return voc;
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-void writeBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+using ::test_support::readBytes;
+using ::test_support::writeBytes;
 
 void feed(slam::System& sys, size_t first, size_t last) {
   for (size_t i = first; i <= last; ++i) {
