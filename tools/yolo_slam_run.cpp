@@ -24,6 +24,7 @@
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/system.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
+#include "yolo_slam/common/thread_name.h"
 
 #include <opencv2/core.hpp>
 
@@ -390,12 +391,13 @@ void setUpBoxes(const Args& args, RunSetup& r) {
     detection::DetectorOptions dopt = detection::DetectorOptions::load(r.cfg);
     if (!args.model.empty()) dopt.model = args.model;
     if (args.single_model) dopt.extra_models.clear();
+    const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(r.cfg);
+    if (aopt.enabled) dopt.threads = aopt.threads;
     r.detector = detection::makeDetector(dopt);
     r.boxes_source = dopt.model;
     for (const auto& m : dopt.extra_models) r.boxes_source += " + " + m;
-    const detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(r.cfg);
     if (aopt.enabled) {
-      r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector));
+      r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector), aopt.min_interval_s);
       r.max_box_age_s = aopt.max_age_s;
       r.boxes_source += " (async)";
     }
@@ -448,9 +450,8 @@ void loadMaskInto(const RunSetup& r, size_t i, Prepared& p) {
   }
 }
 
-// The worker's task: loads frame i and detects people in it (the detector is used by one task
-// at a time).
-Prepared prepareFrame(const RunSetup& r, size_t i) {
+// Reads frame i: image, depth and (synthetic sequences) the ground-truth mask.
+Prepared loadFrame(const RunSetup& r, size_t i) {
   Prepared p;
   p.index = i;
   p.stamp = r.seq.frames()[i].rgb_stamp;
@@ -467,8 +468,15 @@ Prepared prepareFrame(const RunSetup& r, size_t i) {
     p.warning = std::string(e.what()) + " (tracked without depth)";
     p.depth = cv::Mat();
   }
-  detectInto(r, p);
   loadMaskInto(r, i, p);
+  return p;
+}
+
+// The worker's task: loads frame i and detects people in it (the detector is used by one task
+// at a time).
+Prepared prepareFrame(const RunSetup& r, size_t i) {
+  Prepared p = loadFrame(r, i);
+  if (p.has_image) detectInto(r, p);
   return p;
 }
 
@@ -497,9 +505,10 @@ struct LoopResult {
   double fps() const { return total_s > 0 ? static_cast<double>(processed + skipped) / total_s : 0.0; }
 };
 
-std::vector<double> stampsOf(const RunSetup& setup) {
+// The stamps of the run's first `count` frames (all of them by default).
+std::vector<double> stampsOf(const RunSetup& setup, size_t count = SIZE_MAX) {
   std::vector<double> stamps;
-  for (size_t i = 0; i < setup.frames; ++i) stamps.push_back(setup.seq.frames()[i].rgb_stamp);
+  for (size_t i = 0; i < std::min(count, setup.frames); ++i) stamps.push_back(setup.seq.frames()[i].rgb_stamp);
   return stamps;
 }
 
@@ -531,7 +540,10 @@ class PrefetchSource {
 
  private:
   void start(size_t i) {
-    next_ = std::async(std::launch::async, [this, i] { return prepareFrame(setup_, i); });
+    next_ = std::async(std::launch::async, [this, i] {
+      nameThisThread("ys_load_frame");
+      return prepareFrame(setup_, i);
+    });
   }
   const RunSetup& setup_;
   const bool realtime_;
@@ -541,21 +553,38 @@ class PrefetchSource {
   std::future<Prepared> next_;
 };
 
-// --camera-rate: frames as a live camera gives them (io::CameraFeed), newest wins.
+// Every frame read before the camera starts: a live camera hands over decoded images, so
+// decoding the files must not compete with the pipeline (about 2.5 MB per 640x480 frame).
+std::vector<Prepared> loadAllFrames(const RunSetup& setup) {
+  std::fprintf(stderr, "camera-rate: reading %zu frames before the camera starts\n", setup.frames);
+  std::vector<Prepared> frames;
+  frames.reserve(setup.frames);
+  for (size_t i = 0; i < setup.frames && !stopRequested(); ++i) frames.push_back(loadFrame(setup, i));
+  return frames;
+}
+
+// --camera-rate: frames as a live camera gives them (io::CameraFeed), newest wins. With
+// every-frame detection, a frame taken is detected before it is screened, as in a run at full
+// speed, but on the frame loop's thread: the camera does not detect.
 class CameraSource {
  public:
   explicit CameraSource(const RunSetup& setup)
-      : feed_(stampsOf(setup), [&setup](size_t i) { return prepareFrame(setup, i); }) {}
+      : setup_(setup),
+        frames_(loadAllFrames(setup)),
+        feed_(stampsOf(setup, frames_.size()), [this](size_t i) { return std::move(frames_[i]); }) {}
   std::optional<Prepared> next() {
     std::optional<io::CameraFeed<Prepared>::Arrived> a = feed_.next(stopRequested);
     if (!a) return std::nullopt;
     a->frame.arrival = a->due;
+    if (a->frame.has_image) detectInto(setup_, a->frame);
     return std::move(a->frame);
   }
   long offered() const { return feed_.offered(); }
   long dropped() const { return feed_.dropped(); }
 
  private:
+  const RunSetup& setup_;
+  std::vector<Prepared> frames_;  // each moved out once, by the camera thread
   io::CameraFeed<Prepared> feed_;
 };
 
@@ -730,7 +759,8 @@ Json detectionJson(const RunSetup& setup, const LoopResult& res) {
   const detection::AsyncDetectionCounts c = setup.async->counts();
   return Json{{"mode", "async"},           {"max_age_s", setup.max_box_age_s},
               {"offered", c.offered},      {"detected", c.detected},
-              {"replaced", c.replaced},    {"frames_with_new_boxes", res.boxes_fresh},
+              {"replaced", c.replaced},    {"throttled", c.throttled},
+              {"frames_with_new_boxes", res.boxes_fresh},
               {"results_too_old", res.boxes_expired}};
 }
 

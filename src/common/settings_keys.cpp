@@ -61,6 +61,8 @@ const std::vector<std::string>& knownSettingsKeys() {
       "DepthMapFactor",
       "DepthMaxRange",
       "Detection.async",
+      "Detection.asyncMinInterval",
+      "Detection.asyncThreads",
       "Detection.maxAge",
       "Detector.confThreshold",
       "Detector.dynamicClasses",

@@ -4,6 +4,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/common/thread_name.h"
 
 
 namespace yolo_slam {
@@ -13,12 +14,18 @@ AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
   AsyncDetectionOptions o;
   o.enabled = cfg.getBool("Detection.async", o.enabled);
   o.max_age_s = readDouble(cfg, "Detection.maxAge", o.max_age_s, Range::atLeast(0));
+  o.threads = readInt(cfg, "Detection.asyncThreads", o.threads, Range::closed(1, DetectorOptions::kMaxThreads));
+  o.min_interval_s = readDouble(cfg, "Detection.asyncMinInterval", o.min_interval_s, Range::atLeast(0));
   return o;
 }
 
-AsyncDetector::AsyncDetector(std::unique_ptr<Detector> detector) : detector_(std::move(detector)) {
+AsyncDetector::AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s)
+    : detector_(std::move(detector)), min_interval_s_(min_interval_s) {
   if (!detector_) throw Error("AsyncDetector needs a detector");
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    nameThisThread("ys_detect");
+    run();
+  });
 }
 
 AsyncDetector::~AsyncDetector() {
@@ -34,6 +41,10 @@ void AsyncDetector::offer(const cv::Mat& bgr, long index, double stamp) {
   {
     std::lock_guard<std::mutex> lk(mutex_);
     ++counts_.offered;
+    if (!admitLocked(stamp)) {
+      ++counts_.throttled;
+      return;
+    }
     if (pending_) ++counts_.replaced;
     pending_ = Pending{bgr, index, stamp};
   }
@@ -50,6 +61,12 @@ void AsyncDetector::waitIdle() {
   cv_.wait(lk, [this] { return stop_ || (!pending_ && !busy_); });
 }
 
+bool AsyncDetector::admitLocked(double stamp) const {
+  // A stamp before the last taken one starts a new stream (a reset or another sequence).
+  if (!last_taken_stamp_ || stamp < *last_taken_stamp_) return true;
+  return stamp - *last_taken_stamp_ >= min_interval_s_;
+}
+
 AsyncDetectionCounts AsyncDetector::counts() const {
   std::lock_guard<std::mutex> lk(mutex_);
   return counts_;
@@ -62,6 +79,7 @@ void AsyncDetector::run() {
     if (stop_) return;
     Pending job = std::move(*pending_);
     pending_.reset();
+    last_taken_stamp_ = job.stamp;
     busy_ = true;
     lk.unlock();
     DetectionResult r;

@@ -35,7 +35,8 @@ cv::Mat checkedDepth(const cv::Mat& depth_m, const cv::Mat& image, double stamp,
 }  // namespace
 
 FrontEnd::FrontEnd(const features::OrbOptions& orb, const screening::ScreeningOptions& screening)
-    : screening_(std::make_unique<screening::ScreeningPipeline>(screening)) {
+    : needs_boxes_(screening::stagesFor(screening).detection),
+      screening_(std::make_unique<screening::ScreeningPipeline>(screening)) {
   orb.validate();
   for (double boost = 1; boost <= orb.dynamic_boost_max + 1e-9; boost += kBoostStep) {
     features::OrbOptions o = orb;
@@ -79,6 +80,7 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
   if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
   const cv::Mat depth = checkedDepth(depth_m, image, stamp, cam.max_depth);
+  if (detector_ran) seen_detection_ = true;
   const size_t step = budgetStep();
   FrontEndResult r = extractAndScreen(step, image, depth, stamp, boxes, cam, detector_ran);
   // The first frame of a stream has no last frame to size its budget by, and SLAM initialises
@@ -91,6 +93,7 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
     r = extractAndScreen(needed, image, depth, stamp, boxes, cam, detector_ran);
     r.stats.extraction_ms += first_ms;
   }
+  r.awaiting_detection = needs_boxes_ && !seen_detection_;
   return r;
 }
 
@@ -99,6 +102,7 @@ void FrontEnd::clear() {
   screening_->clear();
   dropped_share_ = 0.f;
   fresh_ = true;
+  seen_detection_ = false;
 }
 
 }  // namespace frontend

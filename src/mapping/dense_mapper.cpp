@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/common/thread_name.h"
 
 #include <chrono>
 #include <cstdio>
@@ -42,7 +43,10 @@ void DenseMapper::start() {
   std::lock_guard<std::mutex> lk(queue_mutex_);
   if (!threaded_ || running_ || stop_) return;
   running_ = true;
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    nameThisThread("ys_dense_map");
+    run();
+  });
 }
 
 void DenseMapper::stop() {

@@ -8,6 +8,7 @@
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
 #include "yolo_slam/slam/observation.h"
+#include "yolo_slam/common/thread_name.h"
 
 #include <Eigen/SVD>
 
@@ -31,7 +32,10 @@ void LocalMapping::start() {
   std::lock_guard<std::mutex> lk(queue_mutex_);
   if (thread_.joinable()) return;
   stop_ = false;
-  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] { run(); });
+  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
+    nameThisThread("ys_local_map");
+    run();
+  });
 }
 
 void LocalMapping::stop() {

@@ -12,6 +12,7 @@
 #include "yolo_slam/vocabulary/bow_matcher.h"
 #include "yolo_slam/vocabulary/keyframe_database.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
+#include "yolo_slam/common/thread_name.h"
 
 #include <Eigen/Geometry>
 
@@ -36,7 +37,10 @@ void LoopClosing::start() {
   if (thread_.joinable()) return;
   stop_ = false;
   running_ = true;
-  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] { run(); });
+  if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
+    nameThisThread("ys_loop_close");
+    run();
+  });
 }
 
 void LoopClosing::stop() {
@@ -667,7 +671,10 @@ void LoopClosing::startGlobalBA(long loop_kf_id) {
   gba_stop_.store(false);
   gba_running_.store(true);
   if (mode_ == RunMode::Sequential) runGlobalBA(loop_kf_id);
-  else gba_thread_ = std::thread([this, loop_kf_id] { runGlobalBA(loop_kf_id); });
+  else gba_thread_ = std::thread([this, loop_kf_id] {
+    nameThisThread("ys_global_ba");
+    runGlobalBA(loop_kf_id);
+  });
 }
 
 void LoopClosing::stopGlobalBA() {

@@ -167,9 +167,21 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
     last_frame_ = fe.frame;
     last_boxes_ = fe.boxes;
   }
+  // A map started on a frame screened without boxes would be built on the people in view, and
+  // tracking would hold on to them (asynchronous detection, before its first result).
+  if (fe.awaiting_detection && state() == TrackingState::NotInitialized) return skipAwaitingDetection();
   const TrackResult res = trackFeatures(fe.frame);
   addDenseKeyFrame(res, image, usableDepth(depth_m, image, stamp), fe.boxes);
   return res;
+}
+
+TrackResult System::skipAwaitingDetection() {
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  ++stats_.frames;
+  ++stats_.lost;
+  ++stats_.awaiting_detection;
+  stats_.tracking_ms.push_back(0);  // keeps extraction_ms and tracking_ms frame by frame
+  return TrackResult();
 }
 
 namespace {
@@ -463,6 +475,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"relocalizations", s.relocalizations},
               {"loops_closed", s.loops_closed},
               {"global_bundle_adjustments", s.global_bas},
+              {"awaiting_detection", s.awaiting_detection},
               {"keypoints", s.keypoints},
               {"temporal", s.temporal},
               {"boxes_screened", s.boxes},

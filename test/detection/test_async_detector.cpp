@@ -72,6 +72,33 @@ TEST(AsyncDetector, FramesFlowWhileTheDetectorIsBusyAndOnlyTheNewestWaits) {
   EXPECT_FLOAT_EQ(async.newest()->boxes.at(0).rect.x, 49.f);
 }
 
+// A detector that answers at once with no boxes.
+class InstantDetector : public Detector {
+ public:
+  Boxes detect(const cv::Mat&) override { return {}; }
+  std::string description() const override { return "instant test detector"; }
+};
+
+TEST(AsyncDetector, AMinimumIntervalKeepsFramesFromTheDetector) {
+  AsyncDetector async(std::make_unique<InstantDetector>(), 0.09);
+  // 30 Hz for one second: every third frame is taken (0.1 s apart), the rest never queue.
+  for (int i = 0; i < 30; ++i) {
+    async.offer(imageOf(i), i, i / 30.0);
+    async.waitIdle();
+  }
+  AsyncDetectionCounts c = async.counts();
+  EXPECT_EQ(c.offered, 30);
+  EXPECT_EQ(c.detected, 10);  // frames 0, 3, 6, ... 27
+  EXPECT_EQ(c.throttled, 20);
+  EXPECT_EQ(c.replaced, 0);
+  EXPECT_EQ(async.newest()->frame, 27);
+  // A stamp before the last one taken is a new stream: detected at once.
+  async.offer(imageOf(0), 30, 0.0);
+  async.waitIdle();
+  EXPECT_EQ(async.counts().detected, 11);
+  EXPECT_EQ(async.newest()->frame, 30);
+}
+
 TEST(BoxFeed, AResultServesOneFrameAndExpires) {
   BoxFeed feed(0.2);
   DetectionResult r;
@@ -103,4 +130,13 @@ TEST(AsyncDetectionOptions, LoadsAndRejectsNegativeAge) {
   EXPECT_TRUE(o.enabled);
   EXPECT_DOUBLE_EQ(o.max_age_s, 0.5);
   EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.maxAge: -1\n", "bad.yaml")), Error);
+  EXPECT_EQ(d.threads, 1);
+  EXPECT_DOUBLE_EQ(d.min_interval_s, 0.0);
+  const AsyncDetectionOptions t = AsyncDetectionOptions::load(
+      Config::fromString("Detection.asyncThreads: 2\nDetection.asyncMinInterval: 0.1\n"));
+  EXPECT_EQ(t.threads, 2);
+  EXPECT_DOUBLE_EQ(t.min_interval_s, 0.1);
+  EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.asyncThreads: 0\n", "bad.yaml")), Error);
+  EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.asyncMinInterval: -0.1\n", "bad.yaml")),
+               Error);
 }

@@ -157,3 +157,21 @@ TEST(FrontEnd, RejectsABoostBelowOne) {
   orb.dynamic_boost_max = 0.5;
   EXPECT_THROW(frontend::FrontEnd(orb, screening::ScreeningOptions()), Error);
 }
+
+TEST(FrontEnd, FramesBeforeTheFirstDetectionAreMarkedAwaitingIt) {
+  frontend::FrontEnd fe = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  EXPECT_TRUE(fe.process(texture(1), wallWithPerson(), 0.0, {}, CameraModel(), false).awaiting_detection);
+  EXPECT_TRUE(fe.process(texture(1), wallWithPerson(), 0.033, {}, CameraModel(), false).awaiting_detection);
+  // The detector's first result, even one without people, ends the wait for good.
+  EXPECT_FALSE(fe.process(texture(1), wallWithPerson(), 0.066, {}, CameraModel(), true).awaiting_detection);
+  EXPECT_FALSE(fe.process(texture(1), wallWithPerson(), 0.1, {}, CameraModel(), false).awaiting_detection);
+  fe.clear();  // a map reset: the box tracker starts empty again
+  EXPECT_TRUE(fe.process(texture(1), wallWithPerson(), 0.133, {}, CameraModel(), false).awaiting_detection);
+}
+
+TEST(FrontEnd, ModesWithoutBoxesNeverAwaitADetection) {
+  for (auto mode : {screening::DynamicMode::Off, screening::DynamicMode::Geometry}) {
+    frontend::FrontEnd fe = makeFrontEnd(mode);
+    EXPECT_FALSE(fe.process(texture(1), wallWithPerson(), 0.0, {}, CameraModel(), false).awaiting_detection);
+  }
+}

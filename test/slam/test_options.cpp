@@ -56,6 +56,8 @@ Detector.threads: 3
 Detector.dynamicClasses: [ "person" ]
 Detection.async: 1
 Detection.maxAge: 0.375
+Detection.asyncThreads: 2
+Detection.asyncMinInterval: 0.05
 Screening.mode: "detect"
 Screening.variant: "grow"
 Screening.varianceThreshold: 0.03125

@@ -31,6 +31,14 @@ struct AsyncDetectionOptions {
   // the result's own frame. People walk about 1.4 m/s: in 0.2 s a box at 2 m is off by about a
   // tenth of its width, which the box dilation (Screening.boxDilation) and tracker absorb.
   double max_age_s = 0.2;
+  // Detection.asyncThreads: the detector's threads when asynchronous (replaces Detector.threads).
+  // One leaves the other core of a two-core machine to extraction, tracking and mapping; with
+  // two, every detection takes both cores for its duration and the frame being tracked waits.
+  int threads = 1;
+  // Detection.asyncMinInterval (seconds of stream time): a frame is offered to the detector
+  // only this long after the last frame it took. 0 detects whenever the detector is free; more
+  // leaves CPU to the rest of the pipeline at the cost of carrying boxes over more frames.
+  double min_interval_s = 0;
   static AsyncDetectionOptions load(const Config& cfg);  // throws Error naming file and key
 };
 
@@ -44,11 +52,12 @@ struct DetectionResult {
 
 struct AsyncDetectionCounts {
   long offered = 0, detected = 0, replaced = 0;  // replaced: offered, never detected
+  long throttled = 0;  // offered within min_interval_s of the last frame taken: not queued
 };
 
 class AsyncDetector {
  public:
-  explicit AsyncDetector(std::unique_ptr<Detector> detector);
+  explicit AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s = 0);
   ~AsyncDetector();  // finishes the frame in progress, then stops
   AsyncDetector(const AsyncDetector&) = delete;
   AsyncDetector& operator=(const AsyncDetector&) = delete;
@@ -65,7 +74,11 @@ class AsyncDetector {
  private:
   void run();
 
+  // Whether a frame of this stamp is queued (not within min_interval_s_ of the last taken one).
+  bool admitLocked(double stamp) const;
+
   std::unique_ptr<Detector> detector_;  // used by the worker only
+  const double min_interval_s_;
   // Guards everything below; taken alone. The worker releases it while it detects.
   mutable std::mutex mutex_;
   std::condition_variable cv_;
@@ -75,6 +88,7 @@ class AsyncDetector {
     double stamp = 0;
   };
   std::optional<Pending> pending_;
+  std::optional<double> last_taken_stamp_;  // stamp of the newest frame the worker took
   bool busy_ = false, stop_ = false;
   std::optional<DetectionResult> newest_;
   AsyncDetectionCounts counts_;

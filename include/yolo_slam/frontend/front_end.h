@@ -33,6 +33,9 @@ struct FrontEndResult {
   features::FeatureFrame frame;  // keypoints, depth, and the dynamic flags screening set
   detection::Boxes boxes;        // the boxes screened: detections, then carried ones (tracked)
   FrontEndStats stats;
+  // A mode with person boxes, and no detection has been made since construction or clear():
+  // the frame was screened without boxes (asynchronous detection before its first result).
+  bool awaiting_detection = false;
 };
 
 // One per camera stream: screening remembers tracked boxes and the previous frame.
@@ -70,6 +73,8 @@ class FrontEnd {
   // read without it by the next frame's extraction).
   std::atomic<float> dropped_share_{0.f};
   std::atomic<bool> fresh_{true};  // no frame since construction or clear()
+  const bool needs_boxes_;          // the screening mode uses person boxes
+  std::atomic<bool> seen_detection_{false};  // a frame since construction or clear() was detected
   // Guards screening_ for one frame's whole process(); taken alone.
   std::mutex mutex_;
   std::unique_ptr<screening::ScreeningPipeline> screening_;

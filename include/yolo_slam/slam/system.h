@@ -60,6 +60,8 @@ struct SystemStats {
   size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0, resets = 0;
   size_t keyframes_culled = 0;
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
+  // Frames not tracked because no map may start before the first detection (counted as lost).
+  size_t awaiting_detection = 0;
   screening::ScreeningStats keypoints;  // Screener::screen
   screening::TemporalStats temporal;    // frame-to-frame evidence (propagateLabels, staticBoxVeto)
   BoxCounts boxes;
@@ -178,6 +180,8 @@ class System {
 
  private:
   void resetInternal(bool keep_trajectory);
+  // Counts a frame that is not tracked because no detection has been made yet (Stats).
+  TrackResult skipAwaitingDetection();
   // Around a map replacement (reset, load): loop closing stopped and cleared, local mapping
   // parked and emptied; then both started again (local mapping unless localization-only).
   // Caller holds track_mutex_.
