@@ -80,7 +80,6 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
   if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
   const cv::Mat depth = checkedDepth(depth_m, image, stamp, cam.max_depth);
-  if (detector_ran) seen_detection_ = true;
   const size_t step = budgetStep();
   FrontEndResult r = extractAndScreen(step, image, depth, stamp, boxes, cam, detector_ran);
   // The first frame of a stream has no last frame to size its budget by, and SLAM initialises
@@ -93,6 +92,8 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
     r = extractAndScreen(needed, image, depth, stamp, boxes, cam, detector_ran);
     r.stats.extraction_ms += first_ms;
   }
+  // After the re-extraction above: its clear() forgets earlier detections, not this frame's.
+  if (detector_ran) seen_detection_ = true;
   r.awaiting_detection = needs_boxes_ && !seen_detection_;
   return r;
 }
