@@ -10,6 +10,7 @@
 #include "yolo_slam/common/json.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/progress.h"
+#include "yolo_slam/common/thread_name.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/detection/detector.h"
@@ -24,7 +25,6 @@
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/slam/system.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
-#include "yolo_slam/common/thread_name.h"
 
 #include <opencv2/core.hpp>
 
@@ -720,6 +720,7 @@ LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& 
   if (args.camera_rate) {
     warnAboutStampGaps(setup, "--camera-rate");
     CameraSource feed(setup);
+    total.restart();  // reading the frames up front is not the pipeline's time
     runFrames(feed, setup, system, outputs, res);
     res.camera_offered = feed.offered();
     res.camera_dropped = feed.dropped();
