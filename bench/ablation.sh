@@ -16,6 +16,8 @@
 #   :veto / :noveto   static-box veto on / off (--static-box-veto)
 #   :prop / :noprop   label propagation on / off (--propagate-labels)
 #   :motion / :nomotion   motion screening on / off (--set Screening.motionScreening=1/0)
+#   :nobeyond no screening beyond the boxes (--set Screening.noDepthHoleRadius=0 and
+#             Screening.growOutside=0: the person mask, its growth and the hole rule off)
 #   :single   the main detection model alone, without Detector.extraModels (--single-model)
 #   :every / :async   detection on every frame before it is screened (the paper's pipeline,
 #             the measurements before 2026-12-01) / asynchronous detection (the default)
@@ -86,6 +88,7 @@ suffix_options() {
       noprop) extra+=(--propagate-labels off) ;;
       motion) extra+=(--set Screening.motionScreening=1) ;;
       nomotion) extra+=(--set Screening.motionScreening=0) ;;
+      nobeyond) extra+=(--set Screening.noDepthHoleRadius=0 --set Screening.growOutside=0) ;;
       single) extra+=(--single-model) ;;
       every) extra+=(--detection every-frame) ;;
       async) extra+=(--detection async) ;;
@@ -101,7 +104,7 @@ for m in $modes; do
     off|detect|geometry|detect+geometry) ;;
     *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
-  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :motion :nomotion :single :every :async :seq :camera" >&2; exit 1; }
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :motion :nomotion :nobeyond :single :every :async :seq :camera" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

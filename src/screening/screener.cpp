@@ -1,5 +1,6 @@
 #include "yolo_slam/screening/screener.h"
 #include "yolo_slam/screening/flat_box.h"
+#include "yolo_slam/screening/person_mask.h"
 
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -60,6 +61,8 @@ const OptionTable<ScreeningOptions>& screeningFields() {
       {"Screening.flatBoxFraction", &O::flat_box_fraction, Range::fraction()},
       {"Screening.flatBoxTolerance", &O::flat_box_tolerance, Range::positive()},
       {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
+      {"Screening.growOutside", &O::grow_outside, Range::closed(0, 1)},
+      {"Screening.noDepthHoleRadius", &O::no_depth_hole_radius_px, Range::atLeast(0)},
   };
   return table;
 }
@@ -243,16 +246,14 @@ struct Region {
   std::vector<uint8_t> member;
 };
 
-// The depth image for the silhouette rule, empty when the rule is off; throws unless it is
-// CV_32FC1 of the frame's size.
-cv::Mat silhouetteDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
-                        const cv::Mat& depth_m) {
-  if (o.silhouette_radius_px <= 0 || depth_m.empty()) return cv::Mat();
+// The depth image for the silhouette rule and screening beyond the boxes (may be empty);
+// throws unless it is CV_32FC1 of the frame's size.
+void checkDepthImage(const features::FeatureFrame& frame, const cv::Mat& depth_m) {
+  if (depth_m.empty()) return;
   if (depth_m.type() != CV_32FC1 || depth_m.cols != frame.width || depth_m.rows != frame.height)
     throw Error("screening: the depth image for the silhouette rule must be CV_32FC1 metres of "
                 "the frame's size (" + std::to_string(frame.width) + "x" +
                 std::to_string(frame.height) + ")");
-  return depth_m;
 }
 
 // The modes with geometry need a depth per keypoint.
@@ -375,9 +376,10 @@ uint8_t nearestLabel(const ScreeningOptions& o, const Region& r, const cv::Point
   return label;
 }
 
-// The no-depth rule over the region's keypoints without depth.
+// The no-depth rule over the region's keypoints without depth; person_distance (empty when
+// screening beyond the boxes is off) narrows near-dynamic to holes near a person's pixels.
 void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
-                 std::vector<uint8_t>& drop) {
+                 const cv::Mat& person_distance, std::vector<uint8_t>& drop) {
   using Rule = ScreeningOptions::NoDepthRule;
   if (o.no_depth == Rule::Static) return;
   for (int i : r.idx) {
@@ -385,27 +387,55 @@ void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
     const cv::Point2f p = frame.keypoints[i].pt;
     if (r.core && !inside(*r.core, p)) continue;  // dilation ring: depth only
     bool dynamic = true;  // Rule::Dynamic
-    if (o.no_depth == Rule::NearDynamic) dynamic = memberNear(o, r, p);
+    if (o.no_depth == Rule::NearDynamic) {
+      dynamic = memberNear(o, r, p) &&
+                (person_distance.empty() || distanceAt(person_distance, p) <= o.no_depth_hole_radius_px);
+    }
     if (o.no_depth == Rule::Nearest) dynamic = nearestLabel(o, r, p) != 0;
     if (dynamic) drop[i] = 1;
   }
 }
 
 // Marks one region whose person set findPerson found: the set is dropped, then the silhouette
-// and no-depth rules, unless the flat-box rule leaves the box alone.
-void markRegion(const Screener& s, const features::FeatureFrame& frame, const Region& r,
-                const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+// and no-depth rules. (A flat box is not marked at all.)
+void markRegion(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
+                const cv::Mat& silhouette_depth, const cv::Mat& person_distance,
                 std::vector<uint8_t>& drop, ScreeningStats& st) {
-  const ScreeningOptions& o = s.options();
-  if (r.box && o.reject_flat_boxes && isFlatBox(o, frame, r, boxes)) {
-    ++st.flat_boxes;
-    return;  // a picture or static surface: nothing in this box is dropped
-  }
   for (size_t m = 0; m < r.member.size(); ++m)
     if (r.member[m]) drop[r.with_depth[m]] = 1;
   if (r.box && !silhouette_depth.empty())
     st.silhouette += markSilhouette(o, frame, r, silhouette_depth, drop);
-  markNoDepth(o, frame, r, drop);
+  markNoDepth(o, frame, r, person_distance, drop);
+}
+
+// The grow seeds of a region's person set: its keypoints with depth, their depth range widened
+// by grow_depth_m, and the box widened by grow_outside past the dilation.
+PersonSeeds personSeeds(const ScreeningOptions& o, const Region& r, const cv::Rect2f& box) {
+  PersonSeeds p;
+  p.lo = std::numeric_limits<float>::max();
+  for (size_t m = 0; m < r.member.size(); ++m) {
+    if (!r.member[m]) continue;
+    p.pts.push_back(r.pts[m]);
+    p.lo = std::min(p.lo, r.depths[m]);
+    p.hi = std::max(p.hi, r.depths[m]);
+  }
+  p.lo -= static_cast<float>(o.grow_depth_m);
+  p.hi += static_cast<float>(o.grow_depth_m);
+  p.limit = dilate(box, o.box_dilation + o.grow_outside);
+  return p;
+}
+
+// Screening beyond the boxes: the person pixels of every box not left alone as flat, grown
+// over the depth image; returns the distance image to them (empty when off or without depth).
+cv::Mat personDistanceOf(const ScreeningOptions& o, const std::vector<Region>& regions,
+                         const std::vector<uint8_t>& flat, const detection::Boxes& boxes,
+                         const cv::Mat& depth_m, cv::Mat& mask) {
+  if (o.no_depth_hole_radius_px <= 0 || depth_m.empty()) return cv::Mat();
+  std::vector<PersonSeeds> people;
+  for (size_t b = 0; b < regions.size(); ++b)
+    if (!flat[b]) people.push_back(personSeeds(o, regions[b], boxes[b].rect));
+  mask = growPersonMask(depth_m, people);
+  return personDistance(mask);
 }
 
 // The keypoints of a region's person set.
@@ -463,9 +493,30 @@ void resolveOcclusions(const Screener& s, const features::FeatureFrame& frame, c
   }
 }
 
+// Marks the region of every box (flat boxes left alone), then, with screening beyond the
+// boxes, the keypoints outside every box on or near a person's grown pixels.
+void markBoxes(const Screener& s, const features::FeatureFrame& frame, const detection::Boxes& boxes,
+               const std::vector<Region>& regions, const cv::Mat& depth_m,
+               const std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop, ScreeningStats& st) {
+  const ScreeningOptions& o = s.options();
+  std::vector<uint8_t> flat(regions.size(), 0);
+  for (size_t b = 0; b < regions.size(); ++b) {
+    flat[b] = o.reject_flat_boxes && isFlatBox(o, frame, regions[b], boxes);
+    st.flat_boxes += flat[b];
+  }
+  cv::Mat mask;
+  const cv::Mat distance = personDistanceOf(o, regions, flat, boxes, depth_m, mask);
+  const cv::Mat silhouette_depth = o.silhouette_radius_px > 0 ? depth_m : cv::Mat();
+  for (size_t b = 0; b < regions.size(); ++b)
+    if (!flat[b]) markRegion(o, frame, regions[b], silhouette_depth, distance, drop, st);
+  if (distance.empty()) return;
+  st.grown_outside += markGrownOutside(frame, mask, in_any, drop);
+  st.depth_holes += markHolesOutside(frame, distance, o.no_depth_hole_radius_px, in_any, drop);
+}
+
 // Box modes: the keypoints of each dilated box (in_any) are dropped (detect) or screened.
 void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
-                 const detection::Boxes& boxes, const cv::Mat& silhouette_depth,
+                 const detection::Boxes& boxes, const cv::Mat& depth_m,
                  std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop, ScreeningStats& st) {
   const ScreeningOptions& o = s.options();
   std::vector<cv::Rect2f> dilated(boxes.size());
@@ -490,14 +541,18 @@ void screenBoxes(const Screener& s, const features::FeatureFrame& frame,
   }
   if (o.mode == DynamicMode::Detect) return;
   if (o.occlusion_rule && regions.size() > 1) resolveOcclusions(s, frame, boxes, regions, st);
-  for (const Region& r : regions) markRegion(s, frame, r, boxes, silhouette_depth, drop, st);
+  markBoxes(s, frame, boxes, regions, depth_m, in_any, drop, st);
 }
 
-// Writes the drops of the keypoints in a region into frame.dynamic and counts them.
+// Writes the drops into frame.dynamic and counts those of the keypoints in a region (the
+// drops outside every box are counted by their rules).
 void applyDrops(const std::vector<uint8_t>& in_any, const std::vector<uint8_t>& drop,
                 features::FeatureFrame& frame, ScreeningStats& st) {
   for (size_t i = 0; i < in_any.size(); ++i) {
-    if (!in_any[i]) continue;
+    if (!in_any[i]) {
+      if (drop[i]) frame.dynamic[i] = 1;
+      continue;
+    }
     ++st.in_boxes;
     if (drop[i]) {
       frame.dynamic[i] = 1;
@@ -518,7 +573,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
   if (frame.dynamic.size() != n) frame.dynamic.resize(n, 0);
   checkDepths(opt_, frame);
   if (opt_.mode != DynamicMode::Off) {
-    const cv::Mat silhouette_depth = silhouetteDepth(opt_, frame, depth_m);
+    checkDepthImage(frame, depth_m);
     std::vector<uint8_t> in_any(n, 0), drop(n, 0);
     if (opt_.mode == DynamicMode::Geometry) {
       // The whole image is one region.
@@ -526,9 +581,9 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
       for (size_t i = 0; i < n; ++i) r.idx.push_back(static_cast<int>(i));
       std::fill(in_any.begin(), in_any.end(), 1);
       st.iterations += findPerson(*this, frame, r);
-      markRegion(*this, frame, r, boxes, silhouette_depth, drop, st);
+      markRegion(opt_, frame, r, cv::Mat(), cv::Mat(), drop, st);
     } else {
-      screenBoxes(*this, frame, boxes, silhouette_depth, in_any, drop, st);
+      screenBoxes(*this, frame, boxes, depth_m, in_any, drop, st);
     }
     applyDrops(in_any, drop, frame, st);
   }
@@ -599,6 +654,8 @@ ScreeningStats& ScreeningStats::operator+=(const ScreeningStats& o) {
   flat_boxes += o.flat_boxes;
   silhouette += o.silhouette;
   occluded_boxes += o.occluded_boxes;
+  grown_outside += o.grown_outside;
+  depth_holes += o.depth_holes;
   return *this;
 }
 
@@ -606,6 +663,7 @@ void to_json(Json& j, const ScreeningStats& s) {
   j = Json{{"in_boxes", s.in_boxes},     {"kept", s.kept},
            {"dropped", s.dropped},       {"silhouette", s.silhouette},
            {"flat_boxes", s.flat_boxes}, {"occluded_boxes", s.occluded_boxes},
+           {"grown_outside", s.grown_outside}, {"depth_holes", s.depth_holes},
            {"iterations", s.iterations}};
 }
 

@@ -99,6 +99,17 @@ struct ScreeningOptions {
   // person detected twice and are left as they are. Screening.occlusionRule, occlusionMaxIou.
   bool occlusion_rule = true;
   double occlusion_max_iou = 0.5;
+  // Screening beyond the boxes (person_mask.h; detect+geometry with the depth image passed to
+  // screen()): each box's person set is grown over the depth image by depth continuity, up to
+  // grow_outside of the box's width/height past each side of the box, and keypoints with
+  // depth outside every box on the grown pixels are dropped (a box cuts off an arm, a head, a
+  // carried object). Keypoints without depth are dropped only within no_depth_hole_radius_px
+  // of a grown person pixel: outside the boxes that is a depth hole of the person's outline or
+  // hair; inside a box it narrows the near-dynamic rule, whose holes far from the person are
+  // mostly background beyond the sensor's range. Screening.growOutside (0 = no growth past the
+  // box), Screening.noDepthHoleRadius (pixels; 0 turns both rules and the mask off).
+  double grow_outside = 0.25;
+  double no_depth_hole_radius_px = 20;
   double flat_box_fraction = 0.4;
   double flat_box_tolerance = 0.01;
   double flat_box_ring = 0.25;
@@ -116,7 +127,7 @@ struct ScreeningOptions {
   // noDepth (dynamic | static | nearest | near-dynamic), noDepthRadius (px), silhouetteRadius
   // (px), boxDilation, growRadius (px), growDepth (m), clusterMinFraction, dilationDepthOnly,
   // rejectFlatBoxes, flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing, occlusionRule,
-  // occlusionMaxIou, then the keys of
+  // occlusionMaxIou, growOutside, noDepthHoleRadius (px), then the keys of
   // `tracker` and `temporal`. Invalid values throw yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // The loader's rules, for options set in code (tracker and temporal included); throws
@@ -133,9 +144,13 @@ struct ScreeningStats {
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
   int silhouette = 0;  // of dropped, keypoints the silhouette rule dropped
   int occluded_boxes = 0;  // boxes screened again by the occlusion rule
+  // Keypoints outside every box dropped by screening beyond the boxes (not in in_boxes):
+  int grown_outside = 0;   // with depth, on a person's grown pixels
+  int depth_holes = 0;     // without depth, within noDepthHoleRadius of them
   ScreeningStats& operator+=(const ScreeningStats& o);
 };
-// {"in_boxes", "kept", "dropped", "silhouette", "flat_boxes", "occluded_boxes", "iterations"}
+// {"in_boxes", "kept", "dropped", "silhouette", "flat_boxes", "occluded_boxes", "grown_outside",
+//  "depth_holes", "iterations"}
 // (ms is timed apart).
 void to_json(Json& j, const ScreeningStats& s);
 
@@ -164,8 +179,8 @@ class Screener {
   // Box membership uses frame.keypoints (image pixel coordinates, like the boxes). Boxes are
   // all treated as dynamic-class boxes: the detector filters classes. Each call reseeds the
   // RNG from options().seed, so the result depends only on the frame and the boxes.
-  // depth_m: the frame's depth image in metres (CV_32F, image size) for the silhouette rule;
-  // empty leaves that rule out.
+  // depth_m: the frame's depth image in metres (CV_32F, image size) for the silhouette rule
+  // and screening beyond the boxes; empty leaves those rules out.
   ScreeningStats screen(features::FeatureFrame& frame, const detection::Boxes& boxes,
                         const cv::Mat& depth_m = cv::Mat()) const;
 
