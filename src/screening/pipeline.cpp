@@ -17,8 +17,10 @@ Stages stagesFor(const ScreeningOptions& o) {
 ScreeningPipeline::ScreeningPipeline(const ScreeningOptions& options) : screener_(options) {
   const Stages stages = stagesFor(options);
   if (stages.box_tracking) box_tracker_ = std::make_unique<BoxTracker>(options.tracker);
+  // A vetoed box also keeps what screening beyond the boxes dropped past it.
+  const double veto_reach = options.no_depth_hole_radius_px > 0 ? options.grow_outside : 0.0;
   if (stages.temporal())
-    temporal_ = std::make_unique<TemporalScreening>(options.temporal, options.box_dilation);
+    temporal_ = std::make_unique<TemporalScreening>(options.temporal, options.box_dilation, veto_reach);
 }
 
 PipelineResult ScreeningPipeline::process(features::FeatureFrame& frame,

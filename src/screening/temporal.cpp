@@ -80,8 +80,8 @@ void TemporalOptions::validate(const std::string& where) const {
   checkOptions(*this, where, temporalFields());
 }
 
-TemporalScreening::TemporalScreening(const TemporalOptions& options, double box_dilation)
-    : opt_(options), box_dilation_(box_dilation) {
+TemporalScreening::TemporalScreening(const TemporalOptions& options, double box_dilation, double veto_reach)
+    : opt_(options), box_dilation_(box_dilation), veto_reach_(veto_reach) {
   opt_.validate();
 }
 
@@ -179,8 +179,11 @@ std::vector<int8_t> TemporalScreening::motionVerdicts(const features::FeatureFra
 void TemporalScreening::vetoStaticBoxes(features::FeatureFrame& frame, const detection::Boxes& boxes,
                                         const std::vector<int8_t>& verdict, TemporalStats& st) const {
   const size_t n = frame.size();
-  std::vector<cv::Rect2f> regions;
-  for (const auto& b : boxes) regions.push_back(dilate(b.rect, box_dilation_));
+  std::vector<cv::Rect2f> regions, reach;
+  for (const auto& b : boxes) {
+    regions.push_back(dilate(b.rect, box_dilation_));
+    reach.push_back(dilate(b.rect, box_dilation_ + veto_reach_));
+  }
   std::vector<uint8_t> keep_box(regions.size(), 1);  // 1: the box's verdict stands
   for (size_t b = 0; b < regions.size(); ++b) {
     if (boxes[b].score >= opt_.static_box_max_score) continue;
@@ -200,7 +203,7 @@ void TemporalScreening::vetoStaticBoxes(features::FeatureFrame& frame, const det
     if (!frame.dynamic[i]) continue;
     bool in_vetoed = false, in_standing = false;
     for (size_t b = 0; b < regions.size(); ++b) {
-      if (!inside(regions[b], frame.keypoints[i].pt)) continue;
+      if (!inside(reach[b], frame.keypoints[i].pt)) continue;
       (keep_box[b] ? in_standing : in_vetoed) = true;
     }
     // A keypoint also inside a box whose verdict stands (overlapping people) stays dropped.

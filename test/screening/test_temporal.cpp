@@ -225,6 +225,24 @@ TEST(Temporal, StaticBoxVetoKeepsAnUnsureFalseDetectionButNotAWalkingPerson) {
   EXPECT_EQ(countDynamic(f1, w, true), 60);   // the walking person stays dropped
 }
 
+TEST(Temporal, AVetoedBoxKeepsWhatWasDroppedWithinItsReach) {
+  // The false detection's drops reach past its box, as screening beyond the boxes grows them:
+  // with the reach, the vetoed box keeps them all; without, those past the box stay dropped.
+  const cv::Rect2f inner(75, 75, 120, 120);  // the picture (60, 60, 150, 150) less 15 px a side
+  for (double reach : {0.0, 0.25}) {
+    TemporalScreening ts(vetoOnly(), kBoxDilation, reach);
+    VetoScene v = vetoScene(ts);
+    int past = 0;
+    for (size_t i = 0; i < v.f1.size(); ++i)
+      past += (v.f1.dynamic[i] && !v.w.points[i].person && !screening::inside(inner, v.f1.keypoints[i].pt)) ? 1 : 0;
+    ASSERT_GE(past, 3);
+    const TemporalStats st = ts.apply(v.f1, {box(inner, 0.5f), box(v.person, 0.6f)}, camera());
+    ASSERT_EQ(st.boxes_vetoed, 1) << "reach " << reach;
+    EXPECT_EQ(countDynamic(v.f1, v.w, false), reach > 0 ? 0 : past) << "reach " << reach;
+    EXPECT_EQ(countDynamic(v.f1, v.w, true), 60);
+  }
+}
+
 TEST(Temporal, StaticBoxVetoNeverOverrulesAConfidentDetection) {
   // A seated person is as still as a picture; the detector is sure of people, not of pictures.
   TemporalScreening ts(vetoOnly(), kBoxDilation);

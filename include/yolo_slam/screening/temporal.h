@@ -107,8 +107,10 @@ void to_json(Json& j, const TemporalStats& s);
 class TemporalScreening {
  public:
   // box_dilation: the screener's Screening.boxDilation, so the veto tests the regions it
-  // screened. Validates the options.
-  TemporalScreening(const TemporalOptions& options, double box_dilation);
+  // screened. veto_reach: how far past that (fraction of the box's size per side) the screener
+  // dropped keypoints for a box (Screening.growOutside, when screening beyond the boxes is
+  // on): a vetoed box keeps those too. Validates the options.
+  TemporalScreening(const TemporalOptions& options, double box_dilation, double veto_reach = 0);
   const TemporalOptions& options() const { return opt_; }
 
   // After Screener::screen on `frame` with `boxes`: the static-box veto, motion screening,
@@ -148,6 +150,7 @@ class TemporalScreening {
 
   TemporalOptions opt_;
   double box_dilation_;
+  double veto_reach_;
   features::FeatureFrame prev_;     // keypoints, descriptors, depth, dynamic of the last frame
   std::vector<cv::Point3f> prev_X_;  // its keypoints in its camera frame (z <= 0: no depth)
   std::vector<int> prev_age_;        // label age per keypoint (0: screened or static)
