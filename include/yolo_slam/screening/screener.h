@@ -144,7 +144,8 @@ struct ScreeningStats {
   int flat_boxes = 0;  // boxes left alone by the flat-box rule (reject_flat_boxes)
   int silhouette = 0;  // of dropped, keypoints the silhouette rule dropped
   int occluded_boxes = 0;  // boxes screened again by the occlusion rule
-  // Keypoints outside every box dropped by screening beyond the boxes (not in in_boxes):
+  // Keypoints outside every box dropped by screening beyond the boxes (not in in_boxes;
+  // counted before the static-box veto, which keeps them again when it vetoes their box):
   int grown_outside = 0;   // with depth, on a person's grown pixels
   int depth_holes = 0;     // without depth, within noDepthHoleRadius of them
   ScreeningStats& operator+=(const ScreeningStats& o);
