@@ -52,7 +52,7 @@ Scene makeScene(Probe& p) {
   for (int y = 80; y <= 440; y += 90) s.add(cv::Point2f(110, y), kWall);
   p.arm = s.add({275, 200}, kPerson);             // on the arm, outside the dilated box
   p.arm_past_limit = s.add({305, 200}, kPerson);  // on the arm, past growOutside
-  p.hole_near = s.add({275, 225}, 0.f);           // hole 15 px below the arm
+  p.hole_near = s.add({275, 217}, 0.f);           // hole 8 px below the arm
   p.hole_far = s.add({275, 270}, 0.f);            // no depth, 36 px from the body
   p.box_hole = s.add({115, 300}, 0.f);            // in the box: 37 px from the outline keypoint,
                                                   // 35 px from the person's pixels
@@ -110,7 +110,7 @@ TEST(BeyondBoxes, DropsThePersonsKeypointsOutsideTheBox) {
   Scene s = makeScene(p);
   const ScreeningOptions o;
   ASSERT_EQ(o.grow_outside, 0.25);
-  ASSERT_EQ(o.no_depth_hole_radius_px, 20.0);
+  ASSERT_EQ(o.no_depth_hole_radius_px, 10.0);
   const ScreeningStats st = screenScene(o, s);
   EXPECT_EQ(s.frame.dynamic[p.arm], 1);
   EXPECT_EQ(s.frame.dynamic[p.arm_past_limit], 0);
