@@ -110,7 +110,7 @@ TEST(BeyondBoxes, DropsThePersonsKeypointsOutsideTheBox) {
   Scene s = makeScene(p);
   const ScreeningOptions o;
   ASSERT_EQ(o.grow_outside, 0.25);
-  ASSERT_EQ(o.no_depth_hole_radius_px, 10.0);
+  ASSERT_EQ(o.no_depth_hole_radius_px, 20.0);
   const ScreeningStats st = screenScene(o, s);
   EXPECT_EQ(s.frame.dynamic[p.arm], 1);
   EXPECT_EQ(s.frame.dynamic[p.arm_past_limit], 0);

@@ -109,7 +109,7 @@ struct ScreeningOptions {
   // mostly background beyond the sensor's range. Screening.growOutside (0 = no growth past the
   // box), Screening.noDepthHoleRadius (pixels; 0 turns both rules and the mask off).
   double grow_outside = 0.25;
-  double no_depth_hole_radius_px = 10;
+  double no_depth_hole_radius_px = 20;
   double flat_box_fraction = 0.4;
   double flat_box_tolerance = 0.01;
   double flat_box_ring = 0.25;
