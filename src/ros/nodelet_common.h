@@ -62,19 +62,32 @@ class ErrorThrottle {
   ::ros::WallTime last_time_;
 };
 
+// Whether the nodelet's colour input (`image_topic`, resolved) is rectified: ~rectified true,
+// false or auto (the default: rectified when the topic contains "image_rect"). Throws Error on
+// another value.
+inline bool rectifiedInput(const ::ros::NodeHandle& pnh, const std::string& image_topic) {
+  bool flag = false;
+  if (pnh.getParam("rectified", flag)) return flag;
+  std::string mode = "auto";
+  pnh.getParam("rectified", mode);
+  return isRectified(parseRectified(mode), image_topic);
+}
+
 // The camera model a nodelet works with: the last CameraInfo received (bf, ThDepth and the
 // rest from the settings' model), or the settings' own intrinsics when use_camera_info is
-// false. configure() runs in onInit before any callback; update() and get() run on callback
-// threads.
+// false. `rectified`: the images are rectified (the CameraInfo's P, no distortion; see
+// cameraFromInfo). configure() runs in onInit before any callback; update() and get() run on
+// callback threads.
 class CameraSource {
  public:
-  void configure(const CameraModel& base, bool use_camera_info) {
+  void configure(const CameraModel& base, bool use_camera_info, bool rectified = false) {
     base_ = base;
     use_camera_info_ = use_camera_info;
+    rectified_ = rectified;
   }
   // Throws Error (naming `topic`) when the CameraInfo is unusable; the last good one stays.
   void update(const sensor_msgs::CameraInfo& info, const std::string& topic) {
-    CameraModel cam = cameraFromInfo(info, base_, topic);
+    CameraModel cam = cameraFromInfo(info, base_, topic, rectified_);
     std::lock_guard<std::mutex> lock(mutex_);
     cam_ = cam;
   }
@@ -92,6 +105,7 @@ class CameraSource {
  private:
   CameraModel base_;             // const after configure()
   bool use_camera_info_ = true;  // const after configure()
+  bool rectified_ = false;       // const after configure()
   mutable std::mutex mutex_;     // guards cam_
   std::optional<CameraModel> cam_;
 };

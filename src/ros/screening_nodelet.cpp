@@ -58,7 +58,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("sync_max_interval", max_interval, 0.05);
     try {
       const Config cfg = loadSettings(pnh);
-      camera_.configure(baseCamera(cfg), use_camera_info_);
+      const bool rectified = rectifiedInput(pnh, nh.resolveName(kRgbTopic));
+      camera_.configure(baseCamera(cfg), use_camera_info_, rectified);
       screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
       std::string mode;
       if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
@@ -69,11 +70,11 @@ class ScreeningNodelet : public nodelet::Nodelet {
       pnh.param("async_detection", aopt.enabled, aopt.enabled);
       async_boxes_ = use_boxes_ && aopt.enabled;
       box_feed_ = std::make_unique<detection::BoxFeed>(aopt.max_age_s);
-      NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
+      NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d, %s images",
                    front_end_->extractor().options().n_features, screening::toString(sopt.mode).c_str(),
                    !use_boxes_ ? "rgb+depth (no detector)"
                    : async_boxes_ ? "rgb+depth, newest boxes (async)" : "rgb+depth+boxes synchronised",
-                   queue_size);
+                   queue_size, rectified ? "rectified" : "raw");
     } catch (const std::exception& e) {
       NODELET_ERROR("Screening: bad settings: %s. The nodelet is idle until restarted with "
                     "valid ~settings", e.what());
@@ -89,8 +90,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
     updater_->add(*rate_);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
-    rgb_sub_.subscribe(nh, "camera/rgb/image_color", queue_size);
-    depth_sub_.subscribe(nh, "camera/depth/image", queue_size);
+    rgb_sub_.subscribe(nh, kRgbTopic, queue_size);
+    depth_sub_.subscribe(nh, kDepthTopic, queue_size);
     rgb_sub_.registerCallback(&ScreeningNodelet::onRgbArrived, this);
     if (async_boxes_) {
       // Multi-threaded handle: boxes are stored while a frame is being processed.
@@ -279,6 +280,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
     return boxes_received_;
   }
 
+  // openni2_launch's names: colour, and depth registered to it (16UC1 mm or 32FC1 m).
+  static constexpr const char* kRgbTopic = "camera/rgb/image_raw";
+  static constexpr const char* kDepthTopic = "camera/depth_registered/image_raw";
   static constexpr int kBoxesQueue = 5;             // boxes are small; a few in flight
   static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
