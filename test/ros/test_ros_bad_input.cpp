@@ -41,8 +41,8 @@ class BadInput : public ::testing::Test {
   static void SetUpTestSuite() {
     nh_ = new ros::NodeHandle;
     watch_ = new RosoutWatch(*nh_);
-    rgb_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/rgb/image_color", 10);
-    depth_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/depth/image", 10);
+    rgb_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/rgb/image_raw", 10);
+    depth_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/depth_registered/image_raw", 10);
     info_pub_ = nh_->advertise<sensor_msgs::CameraInfo>("/camera/rgb/camera_info", 1, true);
     kf_pub_ = nh_->advertise<yolo_slam::KeypointFrame>("/yolo_slam/keypoint_frame", 10);
     boxes_sub_ = nh_->subscribe<yolo_slam::BoundingBoxes>(
@@ -151,14 +151,14 @@ TEST_F(BadInput, ScreeningRejectsWrongDepthEncodingAndEmptyDepth) {
         rgb_pub_.publish(toImage(rgb_, enc::BGR8, t));
         depth_pub_.publish(toImage(rgb_, enc::RGB8, t));
       },
-      [] { return logged("unsupported depth encoding 'rgb8' on /camera/depth/image"); }, 15))
+      [] { return logged("unsupported depth encoding 'rgb8' on /camera/depth_registered/image_raw"); }, 15))
       << watch_->dump();
   EXPECT_TRUE(sendUntil(
       [](const ros::Time& t) {
         rgb_pub_.publish(toImage(rgb_, enc::BGR8, t));
         depth_pub_.publish(toImage(cv::Mat(0, 0, CV_32F), enc::TYPE_32FC1, t));
       },
-      [] { return logged("empty image on /camera/depth/image"); }, 15))
+      [] { return logged("empty image on /camera/depth_registered/image_raw"); }, 15))
       << watch_->dump();
   // Unregistered depth (the depth camera's own frame) is refused, not screened pixel for pixel.
   EXPECT_TRUE(sendUntil(

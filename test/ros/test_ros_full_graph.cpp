@@ -1,5 +1,6 @@
 // The full graph on a bag converted from a short synthetic walking sequence (generated at test
-// time with yolo_slam_synth and scripts/tum_to_bag.py), played with rosbag at rate 1:
+// time with yolo_slam_synth and scripts/tum_to_bag.py in the TUM or openni2_launch layout),
+// played with rosbag at rate 1:
 // pose and path published, the tf tree map -> odom -> base_link -> camera complete, no frame
 // dropped, the trajectory saved by the service within an ATE bound. Optionally rviz runs under
 // Xvfb with config/yolo_slam.rviz and a screenshot must show the path and the map points.
@@ -107,6 +108,12 @@ TEST(FullGraph, SyntheticWalkingBag) {
   pnh.param<std::string>("tum_to_bag", script, "");
   pnh.param<std::string>("rviz_config", rviz_config, "");
   pnh.param<std::string>("screenshot", screenshot, "/tmp/yolo_slam_rviz.png");
+  // The bag's layout (scripts/tum_to_bag.py --layout), the colour optical frame its images carry
+  // and that frame's parent in the tf tree (base_link, or the camera driver's chain).
+  std::string layout, camera_frame, camera_parent;
+  pnh.param<std::string>("layout", layout, "tum");
+  pnh.param<std::string>("camera_frame", camera_frame, "openni_rgb_optical_frame");
+  pnh.param<std::string>("camera_parent", camera_parent, "base_link");
   // The Slam nodelet started without ~base_to_camera: it must read base -> camera from tf, which
   // this test publishes as a robot's URDF would (static, before any frame).
   bool mount_from_tf = false;
@@ -116,7 +123,7 @@ TEST(FullGraph, SyntheticWalkingBag) {
     geometry_msgs::TransformStamped t;
     t.header.stamp = ros::Time::now();
     t.header.frame_id = "base_link";
-    t.child_frame_id = "openni_rgb_optical_frame";
+    t.child_frame_id = camera_frame;
     t.transform.rotation.x = -0.5;
     t.transform.rotation.y = 0.5;
     t.transform.rotation.z = -0.5;
@@ -130,7 +137,9 @@ TEST(FullGraph, SyntheticWalkingBag) {
   const std::string dir = tmpl, seq = dir + "/seq", bag = dir + "/seq.bag";
   ASSERT_EQ(run("rosrun yolo_slam yolo_slam_synth --preset " + preset + " --seed 1 --frames " +
                 std::to_string(frames) + " --out " + seq + " > " + dir + "/synth.log 2>&1"), 0);
-  ASSERT_EQ(run("/usr/bin/python3 " + script + " " + seq + " " + bag + " > " + dir + "/bag.log 2>&1"), 0);
+  ASSERT_EQ(run("/usr/bin/python3 " + script + " --layout " + layout + " " + seq + " " + bag + " > " + dir +
+                "/bag.log 2>&1"),
+            0);
 
   ros::Subscriber pose_sub = nh.subscribe<geometry_msgs::PoseStamped>(
       "/yolo_slam/pose", 1000, +[](const geometry_msgs::PoseStamped::ConstPtr&) {
@@ -307,10 +316,10 @@ TEST(FullGraph, SyntheticWalkingBag) {
   std::string err;
   EXPECT_TRUE(tf_buffer.canTransform("map", "odom", ros::Time(0), &err)) << err;
   EXPECT_TRUE(tf_buffer.canTransform("odom", "base_link", ros::Time(0), &err)) << err;
-  EXPECT_TRUE(tf_buffer.canTransform("map", "openni_rgb_optical_frame", ros::Time(0), &err)) << err;
+  EXPECT_TRUE(tf_buffer.canTransform("map", camera_frame, ros::Time(0), &err)) << err;
   std::string parent;
-  EXPECT_TRUE(tf_buffer._getParent("openni_rgb_optical_frame", ros::Time(0), parent));
-  EXPECT_EQ(parent, "base_link");
+  EXPECT_TRUE(tf_buffer._getParent(camera_frame, ros::Time(0), parent));
+  EXPECT_EQ(parent, camera_parent);
   EXPECT_TRUE(tf_buffer._getParent("base_link", ros::Time(0), parent));
   EXPECT_EQ(parent, "odom");
   {
