@@ -39,6 +39,13 @@ TEST(OpenNI2Camera, MissingRecordingNamesTheFile) {
       << watch.dump();
 }
 
+TEST(OpenNI2Camera, MissingNthDeviceSaysHowManyThereAre) {
+  ros::NodeHandle nh;
+  RosoutWatch watch(nh);
+  ASSERT_TRUE(watch.waitFor(rosgraph_msgs::Log::ERROR, "no OpenNI2 device #2 (0 connected)", 1, 20.0))
+      << watch.dump();
+}
+
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_ros_openni2_no_device");
