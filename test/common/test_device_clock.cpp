@@ -29,6 +29,17 @@ TEST(DeviceClock, SpacingIsTheDevicesNotTheHosts) {
   EXPECT_EQ(clock.anchors(), 1);
 }
 
+TEST(DeviceClock, InterleavedStreamsOutOfOrderKeepTheOffset) {
+  DeviceClock clock;
+  const uint64_t t0 = 2000000;
+  clock.toHost(t0, kHostStart);
+  // The depth frame of the same instant is read after the next colour frame.
+  const double colour = clock.toHost(t0 + kFrameUs, kHostStart + 0.040);
+  const double depth = clock.toHost(t0 + kFrameUs - 500, kHostStart + 0.041);
+  EXPECT_NEAR(colour - depth, 500e-6, kTol);
+  EXPECT_EQ(clock.anchors(), 1);
+}
+
 TEST(DeviceClock, RestartedDeviceClockTakesNewOffset) {
   DeviceClock clock;
   clock.toHost(10000000, kHostStart);

@@ -3,7 +3,7 @@
 // since it started; DeviceClock maps that to host time (seconds) by one offset taken at the first
 // frame, so the spacing of the stamps is the device's and not the host's scheduling jitter
 // (openni2_camera's use_device_time). A device clock that restarts (camera re-plugged, recording
-// looped) or drifts too far from the host takes a new offset.
+// looped) or drifts too far from the host (more than max_skew_s) takes a new offset.
 #include <cmath>
 #include <cstdint>
 
@@ -19,13 +19,13 @@ class DeviceClock {
   // Host time (s) of a frame stamped `device_us` by the device and received at `host_now_s`.
   double toHost(uint64_t device_us, double host_now_s) {
     const double device_s = static_cast<double>(device_us) * kSecondsPerMicrosecond;
-    const bool went_back = anchored_ && device_us < last_device_us_;
-    if (!anchored_ || went_back || std::abs(device_s + offset_s_ - host_now_s) > max_skew_s_) {
+    // Only the skew tells a restart: colour and depth frames arrive interleaved, a little out of
+    // stamp order, which must not move the offset.
+    if (!anchored_ || std::abs(device_s + offset_s_ - host_now_s) > max_skew_s_) {
       offset_s_ = host_now_s - device_s;
       anchored_ = true;
       ++anchors_;
     }
-    last_device_us_ = device_us;
     return device_s + offset_s_;
   }
 
@@ -40,7 +40,6 @@ class DeviceClock {
   double max_skew_s_;
   bool anchored_ = false;
   double offset_s_ = 0;
-  uint64_t last_device_us_ = 0;
   int anchors_ = 0;
 };
 
