@@ -135,6 +135,12 @@ sensor_msgs::ImagePtr newImage(int w, int h, const std::string& encoding, int by
   return img;
 }
 
+// The frame holds `height` rows of `stride` bytes, each with `width` pixels.
+bool frameFits(const OniFrame& f, int bytes_per_pixel) {
+  return f.stride >= f.width * bytes_per_pixel &&
+         static_cast<size_t>(f.dataSize) >= static_cast<size_t>(f.stride) * f.height;
+}
+
 const uint8_t* frameRow(const OniFrame& f, int r) {
   return static_cast<const uint8_t*>(f.data) + static_cast<size_t>(r) * f.stride;
 }
@@ -441,10 +447,11 @@ class OpenNI2Camera : public nodelet::Nodelet {
                                         const FieldOfView& fov, int w, int h,
                                         const std::string& frame_id, const ::ros::Time& stamp) {
     auto info = boost::make_shared<sensor_msgs::CameraInfo>();
-    if (calibration.isCalibrated()) *info = calibration.getCameraInfo();
-    const bool usable = calibration.isCalibrated() && info->width == static_cast<uint32_t>(w) &&
+    const bool calibrated = calibration.isCalibrated();
+    if (calibrated) *info = calibration.getCameraInfo();
+    const bool usable = calibrated && info->width == static_cast<uint32_t>(w) &&
                         info->height == static_cast<uint32_t>(h);
-    if (calibration.isCalibrated() && !usable)
+    if (calibrated && !usable)
       NODELET_WARN_THROTTLE(10, "OpenNI2Camera: the calibration is for %ux%u images, the stream "
                             "delivers %dx%d; publishing the device's intrinsics", info->width,
                             info->height, w, h);
@@ -476,8 +483,8 @@ class OpenNI2Camera : public nodelet::Nodelet {
                              "RGB888; frame skipped", static_cast<int>(f.videoMode.pixelFormat));
       return;
     }
+    if (!frameFits(f, 3)) return;
     auto img = newImage(f.width, f.height, enc::RGB8, 3, rgb_frame_id_, stamp);
-    if (static_cast<size_t>(f.dataSize) < img->data.size()) return;
     for (int r = 0; r < f.height; ++r) std::memcpy(&img->data[r * img->step], frameRow(f, r), img->step);
     rgb_.image_raw.publish(img);
     rgb_.info.publish(cameraInfo(*rgb_calibration_, color_fov_, f.width, f.height, rgb_frame_id_, stamp));
@@ -486,7 +493,7 @@ class OpenNI2Camera : public nodelet::Nodelet {
   // Registered depth is pixel-aligned with colour: colour's frame id and calibration
   // (openni2_launch's depth_registered namespace); unregistered depth keeps its own.
   void publishDepth(const OniFrame& f, const ::ros::Time& stamp) {
-    if (static_cast<size_t>(f.dataSize) < static_cast<size_t>(f.width) * f.height * 2) return;
+    if (!frameFits(f, 2)) return;
     CameraTopics& out = registered_ ? depth_registered_ : depth_;
     const std::string& frame_id = registered_ ? rgb_frame_id_ : depth_frame_id_;
     const sensor_msgs::ImagePtr mm = depthMillimetres(f, frame_id, stamp);
