@@ -12,16 +12,30 @@
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/ros/conversions.h"
 
 namespace yolo_slam {
 namespace ros1 {
+
+// The core's messages (settings warnings, map resets, loop closures) to rosconsole, under the
+// logger ros.yolo_slam.core, instead of stderr. Idempotent; every nodelet calls it first.
+inline void routeCoreLogToRosconsole() {
+  log::setSink([](log::Level level, const std::string& message) {
+    switch (level) {
+      case log::Level::Info: ROS_INFO_NAMED("core", "%s", message.c_str()); break;
+      case log::Level::Warn: ROS_WARN_NAMED("core", "%s", message.c_str()); break;
+      case log::Level::Error: ROS_ERROR_NAMED("core", "%s", message.c_str()); break;
+    }
+  });
+}
 
 // The settings file named by ~settings (ORB-SLAM2-style YAML); "" gives an empty Config, so
 // every module keeps its built-in defaults. ~overrides, a list of "Key=value" strings, is applied
 // on top before anything loads (the runner's --set). Throws yolo_slam::Error naming the file or
 // the override.
 inline Config loadSettings(const ::ros::NodeHandle& pnh, std::string* path_out = nullptr) {
+  routeCoreLogToRosconsole();
   std::string path;
   pnh.param<std::string>("settings", path, "");
   if (path_out) *path_out = path;

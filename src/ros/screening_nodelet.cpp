@@ -9,6 +9,7 @@
 // status every second.
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <dynamic_reconfigure/server.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/synchronizer.h>
@@ -27,6 +28,7 @@
 #include "nodelet_common.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
+#include "yolo_slam/ScreeningConfig.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/detection/async_detector.h"
@@ -60,12 +62,15 @@ class ScreeningNodelet : public nodelet::Nodelet {
       const Config cfg = loadSettings(pnh);
       const bool rectified = rectifiedInput(pnh, nh.resolveName(kRgbTopic));
       camera_.configure(baseCamera(cfg), use_camera_info_, rectified);
-      screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
+      screening_options_ = screening::ScreeningOptions::load(cfg);
       std::string mode;
-      if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
+      if (pnh.getParam("dynamic_mode", mode)) screening_options_.mode = screening::parseDynamicMode(mode);
+      else pnh.setParam("dynamic_mode", screening::toString(screening_options_.mode));  // the reconfigure start value
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
-      if (!use_boxes_) sopt.tracker.enabled = false;
-      front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
+      if (!use_boxes_) screening_options_.tracker.enabled = false;
+      orb_options_ = features::OrbOptions::load(cfg);
+      front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
+      const screening::ScreeningOptions& sopt = screening_options_;
       detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
       pnh.param("async_detection", aopt.enabled, aopt.enabled);
       async_boxes_ = use_boxes_ && aopt.enabled;
@@ -113,6 +118,25 @@ class ScreeningNodelet : public nodelet::Nodelet {
     // clock stands still.
     diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
                                      [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
+    reconfigure_->setCallback([this](ScreeningConfig& c, uint32_t) { onReconfigure(c); });
+  }
+
+  // cfg/Screening.cfg. Runs on the nodelet's single-threaded queue, as the frame callbacks: the
+  // front end is rebuilt between two frames (its box tracks and feature budget start afresh).
+  void onReconfigure(ScreeningConfig& c) {
+    screening::DynamicMode mode;
+    try {
+      mode = screening::parseDynamicMode(c.dynamic_mode);
+    } catch (const std::exception& e) {
+      NODELET_ERROR("Screening: %s; keeping %s", e.what(), screening::toString(screening_options_.mode).c_str());
+      c.dynamic_mode = screening::toString(screening_options_.mode);
+      return;
+    }
+    if (mode == screening_options_.mode) return;
+    screening_options_.mode = mode;
+    front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
+    NODELET_INFO("Screening: dynamic mode %s", c.dynamic_mode.c_str());
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -197,9 +221,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
       dropped_ += dropped_now;
     }
     if (dropped_now > 0)
-      NODELET_WARN("Screening: the synchroniser dropped %zu colour frame(s) before %.3f (%zu in "
-                   "total); raise ~queue_size or play the bag slower", dropped_now,
-                   rgb->header.stamp.toSec(), dropped_.load());
+      NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: the synchroniser dropped %zu colour frame(s) before %.3f "
+                            "(%zu in total); raise ~queue_size or play the bag slower", dropped_now,
+                            rgb->header.stamp.toSec(), dropped_.load());
     try {
       Stopwatch sw;
       CameraModel cam = camera();
@@ -220,6 +244,15 @@ class ScreeningNodelet : public nodelet::Nodelet {
       const detection::FrameBoxes boxes = boxesFor(rgb->header.stamp, boxes_msg);
       const frontend::FrontEndResult fe =
           front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes.boxes, cam, boxes.fresh);
+      // A frame screened before any detection came would start the map with people in it.
+      if (fe.awaiting_detection) {
+        const long waited = ++awaiting_detection_;
+        if (waited > kAwaitWarnFrames)
+          NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: %ld frames held back waiting for the first boxes on %s; is "
+                                "the Detector running? (detector:=false screens without boxes)",
+                                waited, async_boxes_sub_.getTopic().c_str());
+        return;
+      }
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;
@@ -272,6 +305,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       st.add("boxes_received", boxesReceived());
       st.add("frames_with_new_boxes", frames_with_new_boxes_.load());
       st.add("boxes_too_old", boxes_too_old_.load());
+      st.add("awaiting_detection", awaiting_detection_.load());
     }
   }
 
@@ -280,10 +314,13 @@ class ScreeningNodelet : public nodelet::Nodelet {
     return boxes_received_;
   }
 
+  using ReconfigureServer = dynamic_reconfigure::Server<ScreeningConfig>;
   // openni2_launch's names: colour, and depth registered to it (16UC1 mm or 32FC1 m).
   static constexpr const char* kRgbTopic = "camera/rgb/image_raw";
   static constexpr const char* kDepthTopic = "camera/depth_registered/image_raw";
   static constexpr int kBoxesQueue = 5;             // boxes are small; a few in flight
+  static constexpr double kWarnPeriodS = 2.0;       // per-frame warnings at most this often
+  static constexpr long kAwaitWarnFrames = 60;      // 2 s of a 30 Hz camera without a detection
   static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
   bool async_boxes_ = true;  // set in onInit
@@ -294,12 +331,19 @@ class ScreeningNodelet : public nodelet::Nodelet {
   // Which result each frame gets (frame callback only, serialised by the synchroniser).
   std::unique_ptr<detection::BoxFeed> box_feed_;
   std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
+  // Frames not published because no detection had arrived yet (FrontEndResult::awaiting_detection).
+  std::atomic<long> awaiting_detection_{0};
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
   bool assume_registered_ = false;  // skip the depth/colour frame id check
-  // Extraction and screening (stateful between frames; used by the frame callback only, which
-  // the synchroniser serialises, like index_).
+  // Extraction and screening (stateful between frames), and the options it is rebuilt from: used
+  // by the frame callback and the reconfigure callback, both on the nodelet's single-threaded
+  // queue, like index_.
+  features::OrbOptions orb_options_;
+  screening::ScreeningOptions screening_options_;
   std::unique_ptr<frontend::FrontEnd> front_end_;
+  boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure's own config lock
+  std::unique_ptr<ReconfigureServer> reconfigure_;
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
