@@ -47,7 +47,7 @@ class DetectorNodelet : public nodelet::Nodelet {
     NODELET_INFO("Detector: input queue %d (%s)%s", input_queue,
                  input_queue == 1 ? "newest image when free" : "every image",
                  async_.min_interval_s > 0 ? ", at most one image per Detection.asyncMinInterval" : "");
-    sub_ = nh.subscribe("camera/rgb/image_color", input_queue, &DetectorNodelet::onImage, this,
+    sub_ = nh.subscribe(kRgbTopic, input_queue, &DetectorNodelet::onImage, this,
                         ::ros::TransportHints().tcpNoDelay());
     stats_timer_ = nh.createWallTimer(::ros::WallDuration(kStatsPeriodS),
                                       [this](const ::ros::WallTimerEvent&) { logStats(); });

@@ -18,6 +18,11 @@
 namespace yolo_slam {
 namespace ros1 {
 
+// The camera topics every nodelet subscribes, named as openni2_launch / rgbd_launch publish them
+// (registered depth, REP 118); launch files remap them to other drivers' or bags' names.
+constexpr const char* kRgbTopic = "camera/rgb/image_raw";
+constexpr const char* kDepthTopic = "camera/depth_registered/image_raw";
+
 // The core's messages (settings warnings, map resets, loop closures) to rosconsole, under the
 // logger ros.yolo_slam.core, instead of stderr. Idempotent; every nodelet calls it first.
 inline void routeCoreLogToRosconsole() {

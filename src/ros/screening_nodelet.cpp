@@ -207,6 +207,22 @@ class ScreeningNodelet : public nodelet::Nodelet {
                 "if the images are registered under other frame names (TUM bags)");
   }
 
+  // A frame screened before any detection arrived would start the map with people in it: held
+  // back (not published), for at most kAwaitMaxS of stream time. A Detector that never answers
+  // must not stop the graph: after that, frames go on without boxes, with a warning.
+  bool holdBack(const ::ros::Time& stamp) {
+    if (first_stamp_.isZero() || stamp < first_stamp_) first_stamp_ = stamp;
+    const double waited_s = (stamp - first_stamp_).toSec();
+    if (waited_s < kAwaitMaxS) {
+      ++awaiting_detection_;
+      return true;
+    }
+    NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: no boxes on %s %.1f s after the first frame; screening "
+                          "without them. Is the Detector running? (detector:=false turns boxes off)",
+                          async_boxes_sub_.getTopic().c_str(), waited_s);
+    return false;
+  }
+
   void process(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const BoundingBoxes::ConstPtr& boxes_msg) {
     size_t dropped_now = 0;
@@ -245,14 +261,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       const frontend::FrontEndResult fe =
           front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes.boxes, cam, boxes.fresh);
       // A frame screened before any detection came would start the map with people in it.
-      if (fe.awaiting_detection) {
-        const long waited = ++awaiting_detection_;
-        if (waited > kAwaitWarnFrames)
-          NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: %ld frames held back waiting for the first boxes on %s; is "
-                                "the Detector running? (detector:=false screens without boxes)",
-                                waited, async_boxes_sub_.getTopic().c_str());
-        return;
-      }
+      if (fe.awaiting_detection && holdBack(rgb->header.stamp)) return;
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;
@@ -316,11 +325,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
 
   using ReconfigureServer = dynamic_reconfigure::Server<ScreeningConfig>;
   // openni2_launch's names: colour, and depth registered to it (16UC1 mm or 32FC1 m).
-  static constexpr const char* kRgbTopic = "camera/rgb/image_raw";
-  static constexpr const char* kDepthTopic = "camera/depth_registered/image_raw";
   static constexpr int kBoxesQueue = 5;             // boxes are small; a few in flight
   static constexpr double kWarnPeriodS = 2.0;       // per-frame warnings at most this often
-  static constexpr long kAwaitWarnFrames = 60;      // 2 s of a 30 Hz camera without a detection
+  static constexpr double kAwaitMaxS = 2.0;         // longest wait for the first detection
   static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
   bool async_boxes_ = true;  // set in onInit
@@ -331,8 +338,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
   // Which result each frame gets (frame callback only, serialised by the synchroniser).
   std::unique_ptr<detection::BoxFeed> box_feed_;
   std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
-  // Frames not published because no detection had arrived yet (FrontEndResult::awaiting_detection).
+  // Frames not published because no detection had arrived yet (FrontEndResult::awaiting_detection),
+  // and the stamp of the first frame (frame callback only).
   std::atomic<long> awaiting_detection_{0};
+  ::ros::Time first_stamp_;
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
   bool assume_registered_ = false;  // skip the depth/colour frame id check

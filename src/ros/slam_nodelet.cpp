@@ -106,7 +106,7 @@ class SlamNodelet : public nodelet::Nodelet {
       pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
       settings_ = loadSettings(pnh, &settings_path);
       if (dense_map_) settings_.set("DenseMap.enabled", "1");
-      camera_.configure(baseCamera(settings_), use_camera_info_);
+      camera_.configure(baseCamera(settings_), use_camera_info_, rectifiedInput(pnh, nh.resolveName(kRgbTopic)));
       if (!voc_path.empty()) {
         Stopwatch sw;
         vocabulary_ = vocabulary::Vocabulary::load(voc_path);
@@ -130,10 +130,10 @@ class SlamNodelet : public nodelet::Nodelet {
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
     // Colour and depth wait in stamp-indexed caches for the keypoint frame made from them.
-    rgb_sub_.subscribe(nh, "camera/rgb/image_color", kImageQueue);
+    rgb_sub_.subscribe(nh, kRgbTopic, kImageQueue);
     rgb_cache_.connectInput(rgb_sub_);
     if (dense_map_) {
-      depth_sub_.subscribe(nh, "camera/depth/image", kImageQueue);
+      depth_sub_.subscribe(nh, kDepthTopic, kImageQueue);
       depth_cache_.connectInput(depth_sub_);
       dense_pub_.advertise(nh, dense_topics);
       save_octomap_srv_ = nh.advertiseService("yolo_slam/save_octomap", &SlamNodelet::onSaveOctomap, this);
