@@ -14,6 +14,7 @@
 #include <functional>
 
 #include "rosout_watch.h"
+#include "test_frames.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
 
@@ -21,18 +22,6 @@ namespace enc = sensor_msgs::image_encodings;
 using rosgraph_msgs::Log;
 
 namespace {
-
-sensor_msgs::ImagePtr toImage(const cv::Mat& m, const std::string& encoding, const ros::Time& t) {
-  auto img = boost::make_shared<sensor_msgs::Image>();
-  img->header.stamp = t;
-  img->header.frame_id = "camera_rgb_optical_frame";
-  img->width = m.cols;
-  img->height = m.rows;
-  img->encoding = encoding;
-  img->step = static_cast<uint32_t>(m.cols * m.elemSize());
-  img->data.assign(m.data, m.data + m.total() * m.elemSize());
-  return img;
-}
 
 class BadInput : public ::testing::Test {
  protected:
@@ -137,13 +126,7 @@ TEST_F(BadInput, MissingCameraInfoIsReportedByScreeningAndSlam) {
 }
 
 TEST_F(BadInput, ScreeningRejectsWrongDepthEncodingAndEmptyDepth) {
-  sensor_msgs::CameraInfo info;
-  info.header.frame_id = "camera_rgb_optical_frame";
-  info.width = 640;
-  info.height = 480;
-  info.K = {535.4, 0, 320.1, 0, 539.2, 247.6, 0, 0, 1};
-  info.distortion_model = "plumb_bob";
-  info.D = {0, 0, 0, 0, 0};
+  const sensor_msgs::CameraInfo info = tum3CameraInfo();
   info_pub_.publish(info);
   ros::WallDuration(0.5).sleep();
   EXPECT_TRUE(sendUntil(

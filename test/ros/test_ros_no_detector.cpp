@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rosout_watch.h"
+#include "test_frames.h"
 #include "yolo_slam/KeypointFrame.h"
 
 namespace enc = sensor_msgs::image_encodings;
@@ -25,18 +26,6 @@ constexpr double kFrameRateHz = 30.0;
 constexpr int kFrames = 150;             // 5 s of stamps
 constexpr double kHoldBackS = 2.0;       // the Screening nodelet's longest wait for boxes
 constexpr double kStampSlackS = 0.1;     // a few frames of scheduling either side
-
-sensor_msgs::ImagePtr toImage(const cv::Mat& m, const std::string& encoding, const ros::Time& t) {
-  auto img = boost::make_shared<sensor_msgs::Image>();
-  img->header.stamp = t;
-  img->header.frame_id = "camera_rgb_optical_frame";
-  img->width = m.cols;
-  img->height = m.rows;
-  img->encoding = encoding;
-  img->step = static_cast<uint32_t>(m.cols * m.elemSize());
-  img->data.assign(m.data, m.data + m.total() * m.elemSize());
-  return img;
-}
 
 std::mutex g_mutex;  // guards g_stamps (subscriber thread vs test thread)
 std::vector<double> g_stamps;
@@ -52,13 +41,7 @@ TEST(NoDetector, FramesFlowWithoutBoxesAfterTheHoldBack) {
         std::lock_guard<std::mutex> lock(g_mutex);
         g_stamps.push_back(m->header.stamp.toSec());
       });
-  sensor_msgs::CameraInfo info;
-  info.header.frame_id = "camera_rgb_optical_frame";
-  info.width = 640;
-  info.height = 480;
-  info.K = {535.4, 0, 320.1, 0, 539.2, 247.6, 0, 0, 1};
-  info.distortion_model = "plumb_bob";
-  info.D = {0, 0, 0, 0, 0};
+  const sensor_msgs::CameraInfo info = tum3CameraInfo();
   info_pub.publish(info);
   const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(30.0);
   while (ros::WallTime::now() < ready && (rgb_pub.getNumSubscribers() < 1 || depth_pub.getNumSubscribers() < 1 ||
