@@ -179,6 +179,16 @@ TEST_F(BadInput, GraphStillRunsAfterwards) {
   EXPECT_EQ(watch_->count(Log::FATAL, ""), 0u);
 }
 
+// The core library's own warnings (here: tracking's motion-model reset on a stamp gap) reach
+// /rosout through the log sink the nodelets install, not the manager's stderr.
+TEST_F(BadInput, CoreWarningsReachRosout) {
+  constexpr double kGapS = 5.0;  // above Tracking.maxStampGap (1 s)
+  ASSERT_TRUE(sendUntil([](const ros::Time&) {}, [] { return poses_ >= 3; }, 30)) << watch_->dump();
+  EXPECT_TRUE(sendUntil([](const ros::Time&) { t_ += kGapS; },
+                        [] { return watch_->count(Log::WARN, "timestamp jump of") > 0; }, 20))
+      << watch_->dump();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
