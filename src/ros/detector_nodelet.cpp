@@ -1,5 +1,6 @@
 // yolo_slam/Detector: YOLO person detection on the colour image; publishes BoundingBoxes with
 // the image's header so the Screening nodelet can pair boxes and images by stamp.
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -25,6 +26,7 @@ class DetectorNodelet : public nodelet::Nodelet {
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<DetectorConfig>;
   static constexpr double kStatsPeriodS = 10.0;
+  static constexpr double kDiagnosticsPeriodS = 1.0;
   static constexpr size_t kTimingWindow = 1000;  // detection times kept for the periodic log
 
   void onInit() override {
@@ -51,6 +53,31 @@ class DetectorNodelet : public nodelet::Nodelet {
                         ::ros::TransportHints().tcpNoDelay());
     stats_timer_ = nh.createWallTimer(::ros::WallDuration(kStatsPeriodS),
                                       [this](const ::ros::WallTimerEvent&) { logStats(); });
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("yolo_slam");
+    updater_->add("detection", this, &DetectorNodelet::fillDiagnostics);
+    // Wall time: diagnostics keep coming while a bag's clock stands still.
+    diag_timer_ = nh.createWallTimer(::ros::WallDuration(kDiagnosticsPeriodS),
+                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+  }
+
+  void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
+    bool loaded = false;
+    {
+      std::lock_guard<std::mutex> lock(detector_mutex_);
+      loaded = enabled_ && detector_;
+    }
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    const Summary s = summarize(ms_);
+    if (loaded)
+      st.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "%zu images detected", frames_);
+    else
+      st.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no detector (disabled or the model did not load): empty boxes");
+    st.add("images", frames_);
+    st.add("rejected_bad_input", rejected_);
+    st.add("throttled", throttled_);
+    st.add("detection_median_ms", s.median);
+    st.add("detection_p95_ms", s.p95);
   }
 
   // Settings, then the private parameters on top. Asynchronous detection runs on
@@ -161,7 +188,9 @@ class DetectorNodelet : public nodelet::Nodelet {
   std::unique_ptr<ReconfigureServer> reconfigure_;
   ::ros::Subscriber sub_;
   ::ros::Publisher pub_;
-  ::ros::WallTimer stats_timer_;
+  ::ros::WallTimer stats_timer_, diag_timer_;
+  // /diagnostics: fillDiagnostics reads the counters under their mutexes.
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
   std::mutex stats_mutex_;  // guards frames_, rejected_, throttled_, ms_ (image callback vs stats timer)
   size_t frames_ = 0, rejected_ = 0, throttled_ = 0;
   std::vector<double> ms_;

@@ -226,7 +226,9 @@ class SlamNodelet : public nodelet::Nodelet {
     }
     try {
       const CameraModel cam = camera();
+      Stopwatch conversion;
       frame = fromMsg(*msg, cam);
+      const double conversion_ms = conversion.ms();
       if (frame.width != cam.width || frame.height != cam.height)
         throw Error("keypoint frame is " + std::to_string(frame.width) + "x" +
                     std::to_string(frame.height) + " but the calibration is " +
@@ -236,9 +238,8 @@ class SlamNodelet : public nodelet::Nodelet {
       if (!system_) startSystem(cam);
       res = system_->trackFeatures(frame);
       corrections = system_->mapCorrections();
-      track_ms_.push_back(sw.ms());
+      recordTimes(sw.ms(), conversion_ms);
       if (dense_map_ && res.keyframe_inserted) handDenseKeyFrame(*msg, res);
-      if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
       if (throttle_.shouldLog(e.what()))
@@ -337,11 +338,27 @@ class SlamNodelet : public nodelet::Nodelet {
                                      [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
   }
 
+  // Caller holds system_mutex_.
+  void recordTimes(double track_ms, double conversion_ms) {
+    for (auto& [v, ms] : {std::pair<std::vector<double>*, double>{&track_ms_, track_ms}, {&conversion_ms_, conversion_ms}}) {
+      v->push_back(ms);
+      if (v->size() > kTimingWindow) v->erase(v->begin(), v->begin() + kTimingWindow / 2);
+    }
+  }
+
   void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
-    Summary track;
+    Summary track, conversion, local_mapping;
+    size_t keyframes = 0, map_points = 0;
     {
       std::lock_guard<std::mutex> lock(system_mutex_);
       track = summarize(track_ms_);
+      conversion = summarize(conversion_ms_);
+      if (system_) {
+        const slam::SystemStats ss = system_->stats();
+        local_mapping = summarize(ss.local_mapping_ms);
+        keyframes = ss.keyframes;
+        map_points = ss.map_points;
+      }
     }
     Summary lat;
     {
@@ -360,6 +377,10 @@ class SlamNodelet : public nodelet::Nodelet {
     st.add("rejected_bad_input", rejected);
     st.add("out_of_order", out_of_order_.load());
     st.add("track_median_ms", track.median);
+    st.add("message_conversion_median_ms", conversion.median);
+    st.add("local_mapping_median_ms", local_mapping.median);
+    st.add("keyframes", keyframes);
+    st.add("map_points", map_points);
     st.add("latency_median_ms", lat.median);
     st.add("latency_p95_ms", lat.p95);
   }
@@ -584,13 +605,14 @@ class SlamNodelet : public nodelet::Nodelet {
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
-  // Guards system_, localization_only_ and track_ms_ (frame callback, map timer, services,
+  // Guards system_, localization_only_, track_ms_ and conversion_ms_ (frame callback, map timer, services,
   // diagnostics). Lock order: system_mutex_ before path_mutex_ (never the reverse).
   std::mutex system_mutex_;
   std::unique_ptr<slam::System> system_;
   bool localization_only_ = false;
   std::string pending_map_;  // loaded when the System starts (set before the first frame)
-  std::vector<double> track_ms_;
+  static constexpr size_t kTimingWindow = 1000;  // timing samples kept for diagnostics
+  std::vector<double> track_ms_, conversion_ms_;
 
   std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
   nav_msgs::Path path_;

@@ -301,6 +301,14 @@ TEST(FullGraph, SyntheticWalkingBag) {
   EXPECT_EQ(received, screened);
   EXPECT_EQ(diagValue("slam", "dropped"), 0);
   EXPECT_GE(tracked, (screened * 9) / 10 - 2);
+  // Where the time goes, per nodelet, on /diagnostics.
+  std::printf("[full_graph] detector: %ld images, detection median %ld ms; slam: conversion median %ld ms, local "
+              "mapping median %ld ms, %ld keyframes\n",
+              diagValue("yolo_detector", "images"), diagValue("yolo_detector", "detection_median_ms"),
+              diagValue("slam", "message_conversion_median_ms"), diagValue("slam", "local_mapping_median_ms"),
+              diagValue("slam", "keyframes"));
+  EXPECT_GT(diagValue("yolo_detector", "images"), 0);
+  EXPECT_GT(diagValue("slam", "keyframes"), 0);
   {
     std::lock_guard<std::mutex> lock(g_mutex);
     std::string names;
