@@ -24,6 +24,10 @@ DEPENDENCIES='
   tf2_eigen:          libtf2-eigen-dev
   cv_bridge:          libcv-bridge-dev
   message_filters:    libmessage-filters-dev
+  image_transport:    libimage-transport-dev
+  dynamic_reconfigure: libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  camera_info_manager: libcamera-info-manager-dev
+  image_geometry:     libimage-geometry-dev
   libopencv-dev:      libopencv-dev
   eigen:              libeigen3-dev
   libceres-dev:       libceres-dev

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Writes a TUM-format RGB-D sequence folder into a ROS bag laid out like the official TUM bags.
 
-Topics: /camera/rgb/image_color (sensor_msgs/Image, rgb8), /camera/depth/image (32FC1, metres),
+--layout tum (default), as the official bags:
+topics /camera/rgb/image_color (sensor_msgs/Image, rgb8), /camera/depth/image (32FC1, metres),
 /camera/rgb/camera_info and /camera/depth/camera_info (sensor_msgs/CameraInfo), /tf of type
 tf/tfMessage as in the official bags (the same definition and md5 as tf2_msgs/TFMessage): the
 chain /world -> /kinect (motion capture) -> /openni_camera -> /openni_rgb_frame ->
@@ -10,8 +11,14 @@ chain /world -> /kinect (motion capture) -> /openni_camera -> /openni_rgb_frame 
 pose in /world is groundtruth.txt. Depth is registered to colour: its images carry the colour
 optical frame id.
 
-usage: scripts/tum_to_bag.py SEQUENCE_DIR OUTPUT.bag [--fx 535.4 --fy 539.2 --cx 320.1 --cy 247.6]
-       [--depth-factor 5000] [--max-diff 0.02]
+--layout openni2, as openni2_launch records a camera (depth_registration:=true):
+topics /camera/rgb/image_raw (rgb8), /camera/rgb/camera_info, /camera/depth_registered/image_raw
+(16UC1, millimetres, REP 118) and /camera/depth_registered/camera_info, every image in
+camera_rgb_optical_frame; the same ground-truth /tf as above. The mount base_link -> camera_link ->
+camera_rgb_optical_frame is not in the bag: the robot (launch/openni2.launch) publishes it.
+
+usage: scripts/tum_to_bag.py SEQUENCE_DIR OUTPUT.bag [--layout tum|openni2]
+       [--fx 535.4 --fy 539.2 --cx 320.1 --cy 247.6] [--depth-factor 5000] [--max-diff 0.02]
 Intrinsics default to SEQUENCE_DIR/camera.yaml when present (yolo_slam_synth writes one),
 else to the freiburg3 values above.
 """
@@ -40,6 +47,19 @@ OPTICAL_IN_BODY = (-0.5, 0.5, -0.5, 0.5)
 
 class TumError(Exception):
     pass
+
+
+MM_PER_M = 1000.0
+# Topic names and frame id of each layout; depth "32FC1" is metres, "16UC1" millimetres.
+LAYOUTS = {
+    "tum": {"rgb": "/camera/rgb/image_color", "rgb_info": "/camera/rgb/camera_info",
+            "depth": "/camera/depth/image", "depth_info": "/camera/depth/camera_info",
+            "depth_encoding": "32FC1", "frame_id": "/openni_rgb_optical_frame"},
+    "openni2": {"rgb": "/camera/rgb/image_raw", "rgb_info": "/camera/rgb/camera_info",
+                "depth": "/camera/depth_registered/image_raw",
+                "depth_info": "/camera/depth_registered/camera_info",
+                "depth_encoding": "16UC1", "frame_id": "camera_rgb_optical_frame"},
+}
 
 
 def read_list(path):
@@ -123,6 +143,25 @@ def stamp_of(t):
     return rospy.Time.from_sec(t)
 
 
+def depth_message(raw, depth_factor, encoding, stamp, frame_id):
+    """REP 118 depth from a TUM depth PNG: 32FC1 metres (NaN = missing, as the TUM bags) or 16UC1
+    millimetres (0 = missing, as openni2_camera)."""
+    m = Image()
+    m.header.stamp = stamp
+    m.header.frame_id = frame_id
+    m.height, m.width, m.encoding, m.is_bigendian = raw.shape[0], raw.shape[1], encoding, 0
+    metres = raw.astype(np.float32) / depth_factor
+    if encoding == "32FC1":
+        metres[raw == 0] = np.nan
+        m.step = 4 * raw.shape[1]
+        m.data = metres.astype("<f4").tobytes()
+    else:
+        mm = np.clip(np.round(metres * MM_PER_M), 0, np.iinfo(np.uint16).max).astype("<u2")
+        m.step = 2 * raw.shape[1]
+        m.data = mm.tobytes()
+    return m
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("sequence")
@@ -133,6 +172,8 @@ def main():
     ap.add_argument("--cy", type=float)
     ap.add_argument("--depth-factor", type=float)
     ap.add_argument("--max-diff", type=float, default=0.02)
+    ap.add_argument("--layout", choices=sorted(LAYOUTS), default="tum",
+                    help="topic names and depth encoding: the official TUM bags' or openni2_launch's")
     args = ap.parse_args()
     seq = args.sequence
     cam = camera_yaml(os.path.join(seq, "camera.yaml"),
@@ -169,7 +210,8 @@ def main():
         ci.P = [cam["fx"], 0, cam["cx"], 0, 0, cam["fy"], cam["cy"], 0, 0, 0, 1, 0]
         return ci
 
-    frame_id = "/openni_rgb_optical_frame"
+    layout = LAYOUTS[args.layout]
+    frame_id = layout["frame_id"]
     with rosbag.Bag(args.bag, "w") as bag:
         for t, v in gt:
             bag.write("/tf", tf_chain(stamp_of(t), v), stamp_of(t))
@@ -188,19 +230,12 @@ def main():
             msg.height, msg.width, msg.encoding, msg.is_bigendian = h, w, "rgb8", 0
             msg.step = 3 * w
             msg.data = cv2.cvtColor(im, cv2.COLOR_BGR2RGB).tobytes()
-            bag.write("/camera/rgb/image_color", msg, stamp_of(tr))
-            bag.write("/camera/rgb/camera_info", info(tr, frame_id, w, h), stamp_of(tr))
-            metres = raw.astype(np.float32) / cam["depth_factor"]
-            metres[raw == 0] = np.nan  # TUM bags mark missing depth with NaN
-            dm = Image()
-            dm.header.stamp = stamp_of(td)
-            dm.header.frame_id = frame_id
-            dm.height, dm.width, dm.encoding, dm.is_bigendian = raw.shape[0], raw.shape[1], "32FC1", 0
-            dm.step = 4 * raw.shape[1]
-            dm.data = metres.astype("<f4").tobytes()
-            bag.write("/camera/depth/image", dm, stamp_of(td))
-            bag.write("/camera/depth/camera_info", info(td, frame_id, raw.shape[1], raw.shape[0]), stamp_of(td))
-    print("tum_to_bag: %d frames, %d poses -> %s" % (len(pairs), len(gt), args.bag))
+            bag.write(layout["rgb"], msg, stamp_of(tr))
+            bag.write(layout["rgb_info"], info(tr, frame_id, w, h), stamp_of(tr))
+            dm = depth_message(raw, cam["depth_factor"], layout["depth_encoding"], stamp_of(td), frame_id)
+            bag.write(layout["depth"], dm, stamp_of(td))
+            bag.write(layout["depth_info"], info(td, frame_id, raw.shape[1], raw.shape[0]), stamp_of(td))
+    print("tum_to_bag: %d frames, %d poses, %s layout -> %s" % (len(pairs), len(gt), args.layout, args.bag))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #include "yolo_slam/common/config.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/common/settings_keys.h"
@@ -107,7 +108,7 @@ void Config::checkKeys(const std::string& text) {
 }
 
 void Config::warn(const std::string& message) {
-  std::fprintf(stderr, "warning: %s\n", message.c_str());
+  log::warn("%s", message.c_str());
   warnings_.push_back(message);
 }
 

@@ -1,6 +1,7 @@
 #include "yolo_slam/io/tum_sequence.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/io/association.h"
@@ -98,7 +99,7 @@ void TumSequence::readGroundTruth(const std::string& path) {
     // Ground truth is optional: a bad line costs the ATE, not the run.
     gt_warning_ = std::string(e.what()) + "; the sequence is run without ground truth (no ATE): fix or "
                   "remove the line";
-    std::fprintf(stderr, "warning: %s\n", gt_warning_.c_str());
+    log::warn("%s", gt_warning_.c_str());
   }
 }
 

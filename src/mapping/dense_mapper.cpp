@@ -1,6 +1,7 @@
 #include "yolo_slam/mapping/dense_mapper.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/common/thread_name.h"
 
@@ -148,7 +149,7 @@ void DenseMapper::processOne(DenseKeyFrame& kf) {
     stats_.integration_ms.push_back(si.ms());
     stats_.integration_cpu_ms.push_back(threadCpuMs() - cpu0);
   } catch (const Error& e) {
-    std::fprintf(stderr, "warning: dense map: keyframe %ld (%.6f) not integrated: %s\n", kf.id, kf.stamp, e.what());
+    log::warn("dense map: keyframe %ld (%.6f) not integrated: %s", kf.id, kf.stamp, e.what());
   }
 }
 

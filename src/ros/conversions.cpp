@@ -1,6 +1,7 @@
 #include "yolo_slam/ros/conversions.h"
 
 #include <cv_bridge/cv_bridge.h>
+#include <image_geometry/pinhole_camera_model.h>
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -213,33 +214,64 @@ void checkFiniteCalibration(const sensor_msgs::CameraInfo& info, const std::stri
 
 }  // namespace
 
+namespace {
+
+// The first five plumb_bob / rational_polynomial coefficients (k1 k2 p1 p2 k3); other models and
+// rectified images get none.
+void setDistortion(CameraModel& cam, const cv::Mat_<double>& D, const std::string& model) {
+  cam.k1 = cam.k2 = cam.p1 = cam.p2 = cam.k3 = 0;
+  if (model != "plumb_bob" && model != "rational_polynomial") return;
+  double* coeffs[] = {&cam.k1, &cam.k2, &cam.p1, &cam.p2, &cam.k3};
+  const int n = static_cast<int>(D.total());
+  for (int i = 0; i < n && i < 5; ++i) *coeffs[i] = D(i);
+}
+
+}  // namespace
+
+Rectified parseRectified(const std::string& value) {
+  if (value == "auto") return Rectified::Auto;
+  if (value == "true") return Rectified::Yes;
+  if (value == "false") return Rectified::No;
+  throw Error("~rectified is '" + value + "'; use auto (rectified if the image topic contains "
+              "image_rect), true or false");
+}
+
+bool isRectified(Rectified mode, const std::string& image_topic) {
+  if (mode == Rectified::Auto) return image_topic.find("image_rect") != std::string::npos;
+  return mode == Rectified::Yes;
+}
+
 CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraModel& base,
-                           const std::string& topic) {
+                           const std::string& topic, bool rectified) {
   if (info.width == 0 || info.height == 0 || info.K[0] <= 0 || info.K[4] <= 0)
     throw Error("camera_info on " + topic + " has no calibration (size " +
                 std::to_string(info.width) + "x" + std::to_string(info.height) + ", fx " +
                 std::to_string(info.K[0]) + "); calibrate the camera or set use_camera_info "
                 "false to use the settings file");
   checkFiniteCalibration(info, topic);
+  if (rectified && (info.P[0] <= 0 || info.P[5] <= 0 || !std::isfinite(info.P[0] + info.P[2] + info.P[5] + info.P[6])))
+    throw Error("camera_info on " + topic + " has no projection matrix P for the rectified images; "
+                "fix the calibration or set ~rectified false");
+  image_geometry::PinholeCameraModel model;
+  try {
+    model.fromCameraInfo(info);
+  } catch (const std::exception& e) {
+    throw Error("camera_info on " + topic + " is not a pinhole calibration: " + e.what());
+  }
   CameraModel cam = base;
   // Keep bf as baseline * fx when fx changes, so ThDepth keeps its meaning in metres.
   const double baseline = base.fx > 0 ? base.bf / base.fx : 0.0;
-  cam.fx = info.K[0];
-  cam.fy = info.K[4];
-  cam.cx = info.K[2];
-  cam.cy = info.K[5];
+  // Raw images: K and D. Rectified images: P (image_geometry's fx()..cy()), already undistorted.
+  const cv::Matx33d& K = model.intrinsicMatrix();
+  cam.fx = rectified ? model.fx() : K(0, 0);
+  cam.fy = rectified ? model.fy() : K(1, 1);
+  cam.cx = rectified ? model.cx() : K(0, 2);
+  cam.cy = rectified ? model.cy() : K(1, 2);
   cam.bf = baseline * cam.fx;
-  cam.width = static_cast<int>(info.width);
-  cam.height = static_cast<int>(info.height);
-  cam.k1 = cam.k2 = cam.p1 = cam.p2 = cam.k3 = 0;
-  if (info.distortion_model == "plumb_bob" || info.distortion_model == "rational_polynomial") {
-    const auto& D = info.D;
-    if (D.size() > 0) cam.k1 = D[0];
-    if (D.size() > 1) cam.k2 = D[1];
-    if (D.size() > 2) cam.p1 = D[2];
-    if (D.size() > 3) cam.p2 = D[3];
-    if (D.size() > 4) cam.k3 = D[4];
-  }
+  const cv::Size size = model.fullResolution();
+  cam.width = size.width;
+  cam.height = size.height;
+  setDistortion(cam, rectified ? cv::Mat_<double>() : model.distortionCoeffs(), info.distortion_model);
   return cam;
 }
 

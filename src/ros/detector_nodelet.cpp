@@ -1,5 +1,7 @@
 // yolo_slam/Detector: YOLO person detection on the colour image; publishes BoundingBoxes with
 // the image's header so the Screening nodelet can pair boxes and images by stamp.
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
@@ -9,10 +11,11 @@
 #include <mutex>
 
 #include "nodelet_common.h"
-#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/BoundingBoxes.h"
+#include "yolo_slam/DetectorConfig.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/detection/detector.h"
 #include "yolo_slam/ros/conversions.h"
 
@@ -21,61 +24,125 @@ namespace ros1 {
 
 class DetectorNodelet : public nodelet::Nodelet {
  private:
+  using ReconfigureServer = dynamic_reconfigure::Server<DetectorConfig>;
+  static constexpr double kStatsPeriodS = 10.0;
+  static constexpr double kDiagnosticsPeriodS = 1.0;
+  static constexpr size_t kTimingWindow = 1000;  // detection times kept for the periodic log
+
   void onInit() override {
     ::ros::NodeHandle& nh = getNodeHandle();
     ::ros::NodeHandle& pnh = getPrivateNodeHandle();
     int queue_size = 30;
     pnh.param("queue_size", queue_size, 30);
-    pnh.param("enabled", enabled_, true);
-    std::string model;
-    pnh.param<std::string>("model", model, "");
     // Asynchronous detection (Detection.async): an input queue of one, so the detector always
     // takes the newest image when it is free and never works through a backlog.
     int input_queue = queue_size;
-    if (enabled_) {
-      try {
-        const Config cfg = loadSettings(pnh);
-        bool async = detection::AsyncDetectionOptions::load(cfg).enabled;
-        pnh.param("async_detection", async, async);
-        if (async) input_queue = 1;
-        detection::DetectorOptions opt = detection::DetectorOptions::load(cfg);
-        if (!model.empty()) opt.model = model;
-        double conf = -1;
-        if (pnh.getParam("conf_threshold", conf)) opt.conf_threshold = static_cast<float>(conf);
-        int threads = 0;
-        if (pnh.getParam("threads", threads)) opt.threads = threads;
-        detector_ = detection::makeDetector(opt);
-        NODELET_INFO("Detector: %s; input queue %d (%s)", detector_->description().c_str(), input_queue,
-                     input_queue == 1 ? "newest image when free" : "every image");
-      } catch (const std::exception& e) {
-        // Without a detector the graph still runs (boxes stay empty, screening finds nothing).
-        NODELET_ERROR("Detector: cannot load the model: %s. Publishing empty boxes; fix ~model "
-                      "or ~settings (Detector.model)", e.what());
-      }
+    try {
+      loadOptions(pnh);
+      if (async_.enabled) input_queue = 1;
+    } catch (const std::exception& e) {
+      NODELET_ERROR("Detector: bad settings: %s. Publishing empty boxes; fix ~settings", e.what());
+      options_ok_ = false;
     }
     pub_ = nh.advertise<BoundingBoxes>("yolo_slam/boxes", queue_size);
-    sub_ = nh.subscribe("camera/rgb/image_color", input_queue, &DetectorNodelet::onImage, this,
+    startReconfigure(pnh);
+    NODELET_INFO("Detector: input queue %d (%s)%s", input_queue,
+                 input_queue == 1 ? "newest image when free" : "every image",
+                 async_.min_interval_s > 0 ? ", at most one image per Detection.asyncMinInterval" : "");
+    sub_ = nh.subscribe(kRgbTopic, input_queue, &DetectorNodelet::onImage, this,
                         ::ros::TransportHints().tcpNoDelay());
-    stats_timer_ = nh.createWallTimer(::ros::WallDuration(10.0), [this](const ::ros::WallTimerEvent&) {
-      std::lock_guard<std::mutex> lock(stats_mutex_);
-      if (frames_ == 0) return;
-      const Summary s = summarize(ms_);
-      NODELET_INFO("Detector: %zu images, %zu rejected, detection median %.1f ms (p95 %.1f)",
-                   frames_, rejected_, s.median, s.p95);
-    });
+    stats_timer_ = nh.createWallTimer(::ros::WallDuration(kStatsPeriodS),
+                                      [this](const ::ros::WallTimerEvent&) { logStats(); });
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("yolo_slam");
+    updater_->add("detection", this, &DetectorNodelet::fillDiagnostics);
+    // Wall time: diagnostics keep coming while a bag's clock stands still.
+    diag_timer_ = nh.createWallTimer(::ros::WallDuration(kDiagnosticsPeriodS),
+                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+  }
+
+  void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
+    bool loaded = false;
+    {
+      std::lock_guard<std::mutex> lock(detector_mutex_);
+      loaded = enabled_ && detector_;
+    }
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    const Summary s = summarize(ms_);
+    if (loaded)
+      st.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "%zu images detected", frames_);
+    else
+      st.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no detector (disabled or the model did not load): empty boxes");
+    st.add("images", frames_);
+    st.add("rejected_bad_input", rejected_);
+    st.add("throttled", throttled_);
+    st.add("detection_median_ms", s.median);
+    st.add("detection_p95_ms", s.p95);
+  }
+
+  // Settings, then the private parameters on top. Asynchronous detection runs on
+  // Detection.asyncThreads threads unless ~threads says otherwise (as the offline runner).
+  void loadOptions(const ::ros::NodeHandle& pnh) {
+    const Config cfg = loadSettings(pnh);
+    async_ = detection::AsyncDetectionOptions::load(cfg);
+    pnh.param("async_detection", async_.enabled, async_.enabled);
+    options_ = detection::DetectorOptions::load(cfg);
+    if (async_.enabled) options_.threads = async_.threads;
+    std::string model;
+    if (pnh.getParam("model", model) && !model.empty()) options_.model = model;
+    int threads = 0;
+    if (pnh.getParam("threads", threads)) options_.threads = threads;
+    // The reconfigure server starts from the parameter server: seed it with the settings.
+    if (!pnh.hasParam("conf_threshold")) pnh.setParam("conf_threshold", options_.conf_threshold);
+  }
+
+  void startReconfigure(const ::ros::NodeHandle& pnh) {
+    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
+    reconfigure_->setCallback([this](DetectorConfig& c, uint32_t) { onReconfigure(c); });
+  }
+
+  // Runs on the private queue, also once from startReconfigure: (re)loads the model when the
+  // detector is wanted and its threshold changed. A failed load leaves no detector (empty boxes).
+  void onReconfigure(DetectorConfig& c) {
+    const float conf = static_cast<float>(c.conf_threshold);
+    std::lock_guard<std::mutex> lock(detector_mutex_);
+    enabled_ = c.enabled;
+    if (!enabled_ || !options_ok_ || (detector_ && conf == options_.conf_threshold)) return;
+    options_.conf_threshold = conf;
+    try {
+      options_.validate("~conf_threshold");
+      detector_ = detection::makeDetector(options_);
+      NODELET_INFO("Detector: %s, confidence %.2f", detector_->description().c_str(), conf);
+    } catch (const std::exception& e) {
+      detector_.reset();
+      // Without a detector the graph still runs (boxes stay empty, screening finds nothing).
+      NODELET_ERROR("Detector: cannot load the model: %s. Publishing empty boxes; fix ~model "
+                    "or ~settings (Detector.model)", e.what());
+    }
+  }
+
+  // Detection.asyncMinInterval in stream time: an image this soon after the last detected one
+  // is skipped (no boxes published; the Screening nodelet keeps the newest result).
+  bool throttled(const ::ros::Time& stamp) {
+    if (async_.min_interval_s <= 0 || last_detected_.isZero()) return false;
+    return (stamp - last_detected_).toSec() < async_.min_interval_s && stamp >= last_detected_;
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& img) {
+    if (throttled(img->header.stamp)) {
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      ++throttled_;
+      return;
+    }
     auto out = boost::make_shared<BoundingBoxes>();
     out->header = img->header;
     try {
-      cv::Mat bgr = imageToBgr(*img, sub_.getTopic());
-      if (detector_) {
+      const cv::Mat bgr = imageToBgr(*img, sub_.getTopic());
+      std::lock_guard<std::mutex> lock(detector_mutex_);
+      if (enabled_ && detector_) {
         Stopwatch sw;
         toMsg(detector_->detect(bgr), *out);
-        std::lock_guard<std::mutex> lock(stats_mutex_);
-        ms_.push_back(sw.ms());
-        if (ms_.size() > 1000) ms_.erase(ms_.begin(), ms_.begin() + 500);
+        recordTime(sw.ms());
       }
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(stats_mutex_);
@@ -83,6 +150,7 @@ class DetectorNodelet : public nodelet::Nodelet {
       if (throttle_.shouldLog(e.what())) NODELET_ERROR("Detector: image rejected: %s", e.what());
       return;
     }
+    last_detected_ = img->header.stamp;
     {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++frames_;
@@ -90,14 +158,41 @@ class DetectorNodelet : public nodelet::Nodelet {
     pub_.publish(out);
   }
 
-  bool enabled_ = true;
+  void recordTime(double ms) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ms_.push_back(ms);
+    if (ms_.size() > kTimingWindow) ms_.erase(ms_.begin(), ms_.begin() + kTimingWindow / 2);
+  }
+
+  void logStats() {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (frames_ == 0) return;
+    const Summary s = summarize(ms_);
+    NODELET_INFO("Detector: %zu images, %zu rejected, %zu throttled, detection median %.1f ms (p95 %.1f)",
+                 frames_, rejected_, throttled_, s.median, s.p95);
+  }
+
+  // Const after onInit, except options_.conf_threshold (under detector_mutex_).
+  detection::AsyncDetectionOptions async_;
+  detection::DetectorOptions options_;
+  bool options_ok_ = true;
   ErrorThrottle throttle_;
-  std::unique_ptr<detection::Detector> detector_;  // used by the image callback only
+
+  // Guards detector_ and enabled_: the image callback vs the reconfigure callback.
+  std::mutex detector_mutex_;
+  std::unique_ptr<detection::Detector> detector_;
+  bool enabled_ = true;
+
+  ::ros::Time last_detected_;  // image callback only (its callbacks are serialised)
+  boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure's own config lock
+  std::unique_ptr<ReconfigureServer> reconfigure_;
   ::ros::Subscriber sub_;
   ::ros::Publisher pub_;
-  ::ros::WallTimer stats_timer_;
-  std::mutex stats_mutex_;  // guards frames_, rejected_, ms_ (image callback vs stats timer)
-  size_t frames_ = 0, rejected_ = 0;
+  ::ros::WallTimer stats_timer_, diag_timer_;
+  // /diagnostics: fillDiagnostics reads the counters under their mutexes.
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::mutex stats_mutex_;  // guards frames_, rejected_, throttled_, ms_ (image callback vs stats timer)
+  size_t frames_ = 0, rejected_ = 0, throttled_ = 0;
   std::vector<double> ms_;
 };
 

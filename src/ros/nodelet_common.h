@@ -12,16 +12,35 @@
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/ros/conversions.h"
 
 namespace yolo_slam {
 namespace ros1 {
+
+// The camera topics every nodelet subscribes, named as openni2_launch / rgbd_launch publish them
+// (registered depth, REP 118); launch files remap them to other drivers' or bags' names.
+constexpr const char* kRgbTopic = "camera/rgb/image_raw";
+constexpr const char* kDepthTopic = "camera/depth_registered/image_raw";
+
+// The core's messages (settings warnings, map resets, loop closures) to rosconsole, under the
+// logger ros.yolo_slam.core, instead of stderr. Idempotent; every nodelet calls it first.
+inline void routeCoreLogToRosconsole() {
+  log::setSink([](log::Level level, const std::string& message) {
+    switch (level) {
+      case log::Level::Info: ROS_INFO_NAMED("core", "%s", message.c_str()); break;
+      case log::Level::Warn: ROS_WARN_NAMED("core", "%s", message.c_str()); break;
+      case log::Level::Error: ROS_ERROR_NAMED("core", "%s", message.c_str()); break;
+    }
+  });
+}
 
 // The settings file named by ~settings (ORB-SLAM2-style YAML); "" gives an empty Config, so
 // every module keeps its built-in defaults. ~overrides, a list of "Key=value" strings, is applied
 // on top before anything loads (the runner's --set). Throws yolo_slam::Error naming the file or
 // the override.
 inline Config loadSettings(const ::ros::NodeHandle& pnh, std::string* path_out = nullptr) {
+  routeCoreLogToRosconsole();
   std::string path;
   pnh.param<std::string>("settings", path, "");
   if (path_out) *path_out = path;
@@ -62,19 +81,32 @@ class ErrorThrottle {
   ::ros::WallTime last_time_;
 };
 
+// Whether the nodelet's colour input (`image_topic`, resolved) is rectified: ~rectified true,
+// false or auto (the default: rectified when the topic contains "image_rect"). Throws Error on
+// another value.
+inline bool rectifiedInput(const ::ros::NodeHandle& pnh, const std::string& image_topic) {
+  bool flag = false;
+  if (pnh.getParam("rectified", flag)) return flag;
+  std::string mode = "auto";
+  pnh.getParam("rectified", mode);
+  return isRectified(parseRectified(mode), image_topic);
+}
+
 // The camera model a nodelet works with: the last CameraInfo received (bf, ThDepth and the
 // rest from the settings' model), or the settings' own intrinsics when use_camera_info is
-// false. configure() runs in onInit before any callback; update() and get() run on callback
-// threads.
+// false. `rectified`: the images are rectified (the CameraInfo's P, no distortion; see
+// cameraFromInfo). configure() runs in onInit before any callback; update() and get() run on
+// callback threads.
 class CameraSource {
  public:
-  void configure(const CameraModel& base, bool use_camera_info) {
+  void configure(const CameraModel& base, bool use_camera_info, bool rectified = false) {
     base_ = base;
     use_camera_info_ = use_camera_info;
+    rectified_ = rectified;
   }
   // Throws Error (naming `topic`) when the CameraInfo is unusable; the last good one stays.
   void update(const sensor_msgs::CameraInfo& info, const std::string& topic) {
-    CameraModel cam = cameraFromInfo(info, base_, topic);
+    CameraModel cam = cameraFromInfo(info, base_, topic, rectified_);
     std::lock_guard<std::mutex> lock(mutex_);
     cam_ = cam;
   }
@@ -92,6 +124,7 @@ class CameraSource {
  private:
   CameraModel base_;             // const after configure()
   bool use_camera_info_ = true;  // const after configure()
+  bool rectified_ = false;       // const after configure()
   mutable std::mutex mutex_;     // guards cam_
   std::optional<CameraModel> cam_;
 };

@@ -9,6 +9,7 @@
 // status every second.
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <dynamic_reconfigure/server.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/synchronizer.h>
@@ -27,6 +28,7 @@
 #include "nodelet_common.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
+#include "yolo_slam/ScreeningConfig.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/detection/async_detector.h"
@@ -56,24 +58,29 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("assume_registered", assume_registered_, false);
     double max_interval = 0.05;
     pnh.param("sync_max_interval", max_interval, 0.05);
+    pnh.param("sync_min_period", sync_min_period_, kDefaultSyncMinPeriodS);
     try {
       const Config cfg = loadSettings(pnh);
-      camera_.configure(baseCamera(cfg), use_camera_info_);
-      screening::ScreeningOptions sopt = screening::ScreeningOptions::load(cfg);
+      const bool rectified = rectifiedInput(pnh, nh.resolveName(kRgbTopic));
+      camera_.configure(baseCamera(cfg), use_camera_info_, rectified);
+      screening_options_ = screening::ScreeningOptions::load(cfg);
       std::string mode;
-      if (pnh.getParam("dynamic_mode", mode)) sopt.mode = screening::parseDynamicMode(mode);
+      if (pnh.getParam("dynamic_mode", mode)) screening_options_.mode = screening::parseDynamicMode(mode);
+      else pnh.setParam("dynamic_mode", screening::toString(screening_options_.mode));  // the reconfigure start value
       // As System::trackRgbd; without the detector's topic there are no boxes to track.
-      if (!use_boxes_) sopt.tracker.enabled = false;
-      front_end_ = std::make_unique<frontend::FrontEnd>(features::OrbOptions::load(cfg), sopt);
+      if (!use_boxes_) screening_options_.tracker.enabled = false;
+      orb_options_ = features::OrbOptions::load(cfg);
+      front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
+      const screening::ScreeningOptions& sopt = screening_options_;
       detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
       pnh.param("async_detection", aopt.enabled, aopt.enabled);
       async_boxes_ = use_boxes_ && aopt.enabled;
       box_feed_ = std::make_unique<detection::BoxFeed>(aopt.max_age_s);
-      NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d",
+      NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d, %s images",
                    front_end_->extractor().options().n_features, screening::toString(sopt.mode).c_str(),
                    !use_boxes_ ? "rgb+depth (no detector)"
                    : async_boxes_ ? "rgb+depth, newest boxes (async)" : "rgb+depth+boxes synchronised",
-                   queue_size);
+                   queue_size, rectified ? "rectified" : "raw");
     } catch (const std::exception& e) {
       NODELET_ERROR("Screening: bad settings: %s. The nodelet is idle until restarted with "
                     "valid ~settings", e.what());
@@ -89,8 +96,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
     updater_->add(*rate_);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
-    rgb_sub_.subscribe(nh, "camera/rgb/image_color", queue_size);
-    depth_sub_.subscribe(nh, "camera/depth/image", queue_size);
+    rgb_sub_.subscribe(nh, kRgbTopic, queue_size);
+    depth_sub_.subscribe(nh, kDepthTopic, queue_size);
     rgb_sub_.registerCallback(&ScreeningNodelet::onRgbArrived, this);
     if (async_boxes_) {
       // Multi-threaded handle: boxes are stored while a frame is being processed.
@@ -106,12 +113,34 @@ class ScreeningNodelet : public nodelet::Nodelet {
       sync2_ = std::make_unique<Sync2>(sp::ApproximateTime<Image, Image>(queue_size), rgb_sub_,
                                        depth_sub_);
       sync2_->setMaxIntervalDuration(::ros::Duration(max_interval));
+      // Knowing that images come at least this far apart, the synchroniser emits a pair as soon
+      // as both images are there, instead of holding it until the next frame proves it best.
+      if (sync_min_period_ > 0) sync2_->setInterMessageLowerBound(::ros::Duration(sync_min_period_));
       sync2_->registerCallback(&ScreeningNodelet::onFrame2, this);
     }
     // Wall time, not Updater::update's ROS-time period: diagnostics keep coming while a bag's
     // clock stands still.
     diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
                                      [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
+    reconfigure_->setCallback([this](ScreeningConfig& c, uint32_t) { onReconfigure(c); });
+  }
+
+  // cfg/Screening.cfg. Runs on the nodelet's single-threaded queue, as the frame callbacks: the
+  // front end is rebuilt between two frames (its box tracks and feature budget start afresh).
+  void onReconfigure(ScreeningConfig& c) {
+    screening::DynamicMode mode;
+    try {
+      mode = screening::parseDynamicMode(c.dynamic_mode);
+    } catch (const std::exception& e) {
+      NODELET_ERROR("Screening: %s; keeping %s", e.what(), screening::toString(screening_options_.mode).c_str());
+      c.dynamic_mode = screening::toString(screening_options_.mode);
+      return;
+    }
+    if (mode == screening_options_.mode) return;
+    screening_options_.mode = mode;
+    front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
+    NODELET_INFO("Screening: dynamic mode %s", c.dynamic_mode.c_str());
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -182,6 +211,22 @@ class ScreeningNodelet : public nodelet::Nodelet {
                 "if the images are registered under other frame names (TUM bags)");
   }
 
+  // A frame screened before any detection arrived would start the map with people in it: held
+  // back (not published), for at most kAwaitMaxS of stream time. A Detector that never answers
+  // must not stop the graph: after that, frames go on without boxes, with a warning.
+  bool holdBack(const ::ros::Time& stamp) {
+    if (first_stamp_.isZero() || stamp < first_stamp_) first_stamp_ = stamp;
+    const double waited_s = (stamp - first_stamp_).toSec();
+    if (waited_s < kAwaitMaxS) {
+      ++awaiting_detection_;
+      return true;
+    }
+    NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: no boxes on %s %.1f s after the first frame; screening "
+                          "without them. Is the Detector running? (detector:=false turns boxes off)",
+                          async_boxes_sub_.getTopic().c_str(), waited_s);
+    return false;
+  }
+
   void process(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const BoundingBoxes::ConstPtr& boxes_msg) {
     size_t dropped_now = 0;
@@ -196,9 +241,9 @@ class ScreeningNodelet : public nodelet::Nodelet {
       dropped_ += dropped_now;
     }
     if (dropped_now > 0)
-      NODELET_WARN("Screening: the synchroniser dropped %zu colour frame(s) before %.3f (%zu in "
-                   "total); raise ~queue_size or play the bag slower", dropped_now,
-                   rgb->header.stamp.toSec(), dropped_.load());
+      NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: the synchroniser dropped %zu colour frame(s) before %.3f "
+                            "(%zu in total); raise ~queue_size or play the bag slower", dropped_now,
+                            rgb->header.stamp.toSec(), dropped_.load());
     try {
       Stopwatch sw;
       CameraModel cam = camera();
@@ -219,6 +264,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
       const detection::FrameBoxes boxes = boxesFor(rgb->header.stamp, boxes_msg);
       const frontend::FrontEndResult fe =
           front_end_->process(image, depth_m, rgb->header.stamp.toSec(), boxes.boxes, cam, boxes.fresh);
+      // A frame screened before any detection came would start the map with people in it.
+      if (fe.awaiting_detection && holdBack(rgb->header.stamp)) return;
       auto out = boost::make_shared<KeypointFrame>();
       out->header = rgb->header;
       out->depth_stamp = depth->header.stamp;
@@ -271,6 +318,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
       st.add("boxes_received", boxesReceived());
       st.add("frames_with_new_boxes", frames_with_new_boxes_.load());
       st.add("boxes_too_old", boxes_too_old_.load());
+      st.add("awaiting_detection", awaiting_detection_.load());
     }
   }
 
@@ -279,7 +327,14 @@ class ScreeningNodelet : public nodelet::Nodelet {
     return boxes_received_;
   }
 
+  using ReconfigureServer = dynamic_reconfigure::Server<ScreeningConfig>;
+  // openni2_launch's names: colour, and depth registered to it (16UC1 mm or 32FC1 m).
   static constexpr int kBoxesQueue = 5;             // boxes are small; a few in flight
+  static constexpr double kWarnPeriodS = 2.0;       // per-frame warnings at most this often
+  // Colour and depth come at least this far apart (seconds): true of every camera up to 50 Hz.
+  static constexpr double kDefaultSyncMinPeriodS = 0.02;
+  double sync_min_period_ = kDefaultSyncMinPeriodS;  // ~sync_min_period, const after onInit
+  static constexpr double kAwaitMaxS = 2.0;         // longest wait for the first detection
   static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
   bool async_boxes_ = true;  // set in onInit
@@ -290,12 +345,21 @@ class ScreeningNodelet : public nodelet::Nodelet {
   // Which result each frame gets (frame callback only, serialised by the synchroniser).
   std::unique_ptr<detection::BoxFeed> box_feed_;
   std::atomic<long> frames_with_new_boxes_{0}, boxes_too_old_{0};
+  // Frames not published because no detection had arrived yet (FrontEndResult::awaiting_detection),
+  // and the stamp of the first frame (frame callback only).
+  std::atomic<long> awaiting_detection_{0};
+  ::ros::Time first_stamp_;
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;
   bool assume_registered_ = false;  // skip the depth/colour frame id check
-  // Extraction and screening (stateful between frames; used by the frame callback only, which
-  // the synchroniser serialises, like index_).
+  // Extraction and screening (stateful between frames), and the options it is rebuilt from: used
+  // by the frame callback and the reconfigure callback, both on the nodelet's single-threaded
+  // queue, like index_.
+  features::OrbOptions orb_options_;
+  screening::ScreeningOptions screening_options_;
   std::unique_ptr<frontend::FrontEnd> front_end_;
+  boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure's own config lock
+  std::unique_ptr<ReconfigureServer> reconfigure_;
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 

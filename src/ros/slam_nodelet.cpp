@@ -3,8 +3,13 @@
 // covisibility edges and a debug image; services reset, save_trajectory (TUM format),
 // set_localization_mode, save_map and load_map (map files).
 #include <cv_bridge/cv_bridge.h>
-#include <diagnostic_msgs/DiagnosticArray.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseStamped.h>
+#include <image_transport/image_transport.h>
+#include <message_filters/cache.h>
+#include <message_filters/subscriber.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Path.h>
 #include <nodelet/nodelet.h>
@@ -14,27 +19,26 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/image_encodings.h>
-#include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <opencv2/imgproc.hpp>
 
 #include <atomic>
-#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
 
 #include "dense_map_publisher.h"
+#include "map_messages.h"
 #include "nodelet_common.h"
 #include "pose_output.h"
 #include "yolo_slam/KeypointFrame.h"
 #include "yolo_slam/MapFile.h"
 #include "yolo_slam/SaveTrajectory.h"
+#include "yolo_slam/SlamConfig.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/timing.h"
-#include "yolo_slam/detection/draw.h"
 #include "yolo_slam/io/trajectory.h"
 #include "yolo_slam/ros/conversions.h"
 #include "yolo_slam/slam/system.h"
@@ -88,8 +92,8 @@ class SlamNodelet : public nodelet::Nodelet {
     pnh.param<std::string>("map_file", map_file_, "");
     pnh.param("localization_mode", localization_only_, false);
     pending_map_ = map_file_;
-    pnh.param("map_publish_period", map_period_, 1.0);
-    pnh.param("debug_image", debug_image_, true);
+    pnh.param("min_rate_hz", min_rate_hz_, kDefaultMinRateHz);
+    pnh.param("max_rate_hz", max_rate_hz_, kDefaultMaxRateHz);
     pnh.param("dense_map", dense_map_, false);
     pnh.param("dense_map_publish_period", dense_period_, 2.0);
     pnh.param<std::string>("octomap_path", octomap_path_, "");
@@ -102,7 +106,7 @@ class SlamNodelet : public nodelet::Nodelet {
       pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
       settings_ = loadSettings(pnh, &settings_path);
       if (dense_map_) settings_.set("DenseMap.enabled", "1");
-      camera_.configure(baseCamera(settings_), use_camera_info_);
+      camera_.configure(baseCamera(settings_), use_camera_info_, rectifiedInput(pnh, nh.resolveName(kRgbTopic)));
       if (!voc_path.empty()) {
         Stopwatch sw;
         vocabulary_ = vocabulary::Vocabulary::load(voc_path);
@@ -120,14 +124,17 @@ class SlamNodelet : public nodelet::Nodelet {
     path_pub_ = nh.advertise<nav_msgs::Path>("yolo_slam/path", 1, true);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("yolo_slam/map_points", 1, true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
-    debug_pub_ = nh.advertise<sensor_msgs::Image>("yolo_slam/debug_image", 2);
-    diag_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+    image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+    debug_pub_ = image_transport_->advertise("yolo_slam/debug_image", 2);
+    startDiagnostics(nh, pnh);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
-    if (debug_image_ || dense_map_)
-      rgb_sub_ = nh.subscribe("camera/rgb/image_color", 30, &SlamNodelet::onRgb, this);
+    // Colour and depth wait in stamp-indexed caches for the keypoint frame made from them.
+    rgb_sub_.subscribe(nh, kRgbTopic, kImageQueue);
+    rgb_cache_.connectInput(rgb_sub_);
     if (dense_map_) {
-      depth_sub_ = nh.subscribe("camera/depth/image", 30, &SlamNodelet::onDepth, this);
+      depth_sub_.subscribe(nh, kDepthTopic, kImageQueue);
+      depth_cache_.connectInput(depth_sub_);
       dense_pub_.advertise(nh, dense_topics);
       save_octomap_srv_ = nh.advertiseService("yolo_slam/save_octomap", &SlamNodelet::onSaveOctomap, this);
       if (dense_period_ > 0)
@@ -142,11 +149,10 @@ class SlamNodelet : public nodelet::Nodelet {
                                    this);
     save_map_srv_ = nh.advertiseService("yolo_slam/save_map", &SlamNodelet::onSaveMap, this);
     load_map_srv_ = nh.advertiseService("yolo_slam/load_map", &SlamNodelet::onLoadMap, this);
-    if (map_period_ > 0)
-      map_timer_ = nh.createWallTimer(::ros::WallDuration(map_period_),
-                                      [this](const ::ros::WallTimerEvent&) { publishMap(); });
-    diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
-                                     [this](const ::ros::WallTimerEvent&) { publishDiagnostics(); });
+    // Stopped until the reconfigure server hands over ~map_publish_period.
+    map_timer_ = nh.createWallTimer(::ros::WallDuration(1.0), [this](const ::ros::WallTimerEvent&) { publishMap(); },
+                                    false, false);
+    startReconfigure(pnh);
     NODELET_INFO("Slam: tf %s, settings '%s'", pose_out_->describe().c_str(), settings_path.c_str());
   }
 
@@ -158,35 +164,18 @@ class SlamNodelet : public nodelet::Nodelet {
     }
   }
 
-  void onRgb(const sensor_msgs::ImageConstPtr& img) {
-    std::lock_guard<std::mutex> lock(rgb_mutex_);
-    recent_rgb_.push_back(img);
-    while (recent_rgb_.size() > kRecentImages) recent_rgb_.pop_front();
-  }
-
-  void onDepth(const sensor_msgs::ImageConstPtr& img) {
-    std::lock_guard<std::mutex> lock(rgb_mutex_);
-    recent_depth_.push_back(img);
-    while (recent_depth_.size() > kRecentImages) recent_depth_.pop_front();
-  }
-
-  // The newest of `images` with this stamp (null if gone). Caller holds rgb_mutex_.
-  static sensor_msgs::ImageConstPtr findByStamp(const std::deque<sensor_msgs::ImageConstPtr>& images,
+  // The cached image with exactly this stamp (null when it is gone or never came).
+  static sensor_msgs::ImageConstPtr findByStamp(message_filters::Cache<sensor_msgs::Image>& cache,
                                                 const ::ros::Time& stamp) {
-    for (auto it = images.rbegin(); it != images.rend(); ++it)
-      if ((*it)->header.stamp == stamp) return *it;
-    return nullptr;
+    const auto found = cache.getInterval(stamp, stamp);
+    return found.empty() ? nullptr : found.back();
   }
 
   // A new keyframe's colour, depth and boxes to the dense map. Caller holds system_mutex_,
   // right after the trackFeatures that made the keyframe. A missing image skips the keyframe.
   void handDenseKeyFrame(const KeypointFrame& msg, const slam::TrackResult& res) {
-    sensor_msgs::ImageConstPtr rgb, depth;
-    {
-      std::lock_guard<std::mutex> lock(rgb_mutex_);
-      rgb = findByStamp(recent_rgb_, msg.header.stamp);
-      depth = findByStamp(recent_depth_, msg.depth_stamp);
-    }
+    const sensor_msgs::ImageConstPtr rgb = findByStamp(rgb_cache_, msg.header.stamp);
+    const sensor_msgs::ImageConstPtr depth = findByStamp(depth_cache_, msg.depth_stamp);
     try {
       if (!depth) throw Error("its depth image is no longer buffered");
       const cv::Mat bgr = rgb ? imageToBgr(*rgb, rgb_sub_.getTopic()) : cv::Mat();
@@ -211,7 +200,7 @@ class SlamNodelet : public nodelet::Nodelet {
       return true;
     }
     ++out_of_order_;
-    NODELET_WARN_THROTTLE(2.0, "Slam: frame %.6f is not newer than the last one (%.6f): dropped, %zu "
+    NODELET_WARN_THROTTLE(kWarnPeriodS, "Slam: frame %.6f is not newer than the last one (%.6f): dropped, %zu "
                           "out-of-order frame(s) so far; call yolo_slam/reset when a bag restarts",
                           stamp, last, out_of_order_.load());
     return false;
@@ -221,9 +210,9 @@ class SlamNodelet : public nodelet::Nodelet {
     if (last_index_ != 0 && msg->index > last_index_ + 1) {
       const size_t gap = msg->index - last_index_ - 1;
       dropped_ += gap;
-      NODELET_WARN("Slam: %zu keypoint frame(s) dropped before %.3f (%zu in total); raise "
-                   "~queue_size or play the bag slower", gap, msg->header.stamp.toSec(),
-                   dropped_.load());
+      NODELET_WARN_THROTTLE(kWarnPeriodS, "Slam: %zu keypoint frame(s) dropped before %.3f (%zu in total); "
+                            "raise ~queue_size or play the bag slower", gap, msg->header.stamp.toSec(),
+                            dropped_.load());
     }
     last_index_ = msg->index;
     ++received_;
@@ -237,7 +226,9 @@ class SlamNodelet : public nodelet::Nodelet {
     }
     try {
       const CameraModel cam = camera();
+      Stopwatch conversion;
       frame = fromMsg(*msg, cam);
+      const double conversion_ms = conversion.ms();
       if (frame.width != cam.width || frame.height != cam.height)
         throw Error("keypoint frame is " + std::to_string(frame.width) + "x" +
                     std::to_string(frame.height) + " but the calibration is " +
@@ -247,9 +238,8 @@ class SlamNodelet : public nodelet::Nodelet {
       if (!system_) startSystem(cam);
       res = system_->trackFeatures(frame);
       corrections = system_->mapCorrections();
-      track_ms_.push_back(sw.ms());
+      recordTimes(sw.ms(), conversion_ms);
       if (dense_map_ && res.keyframe_inserted) handDenseKeyFrame(*msg, res);
-      if (track_ms_.size() > 1000) track_ms_.erase(track_ms_.begin(), track_ms_.begin() + 500);
     } catch (const std::exception& e) {
       ++rejected_;
       if (throttle_.shouldLog(e.what()))
@@ -263,7 +253,7 @@ class SlamNodelet : public nodelet::Nodelet {
       recordLatency(msg->header.stamp);
     } else {
       ++not_tracked_;
-      NODELET_WARN_THROTTLE(2.0, "Slam: tracking %s at %.3f (%d inliers)", stateName(res.state),
+      NODELET_WARN_THROTTLE(kWarnPeriodS, "Slam: tracking %s at %.3f (%d inliers)", stateName(res.state),
                             msg->header.stamp.toSec(), res.inliers);
     }
     if (debug_image_ && debug_pub_.getNumSubscribers() > 0) publishDebug(*msg, res);
@@ -279,6 +269,7 @@ class SlamNodelet : public nodelet::Nodelet {
 
   void publishPose(const KeypointFrame& msg, const slam::TrackResult& res, size_t corrections) {
     const geometry_msgs::PoseStamped ps = pose_out_->publish(msg.header.stamp, res.T_wc, res.inliers, corrections);
+    pose_rate_->tick();
     std::lock_guard<std::mutex> lock(path_mutex_);
     path_.header = ps.header;
     path_.poses.push_back(ps);
@@ -286,39 +277,14 @@ class SlamNodelet : public nodelet::Nodelet {
   }
 
   void publishDebug(const KeypointFrame& msg, const slam::TrackResult& res) {
-    sensor_msgs::ImageConstPtr rgb;
-    {
-      std::lock_guard<std::mutex> lock(rgb_mutex_);
-      for (auto it = recent_rgb_.rbegin(); it != recent_rgb_.rend(); ++it)
-        if ((*it)->header.stamp == msg.header.stamp) {
-          rgb = *it;
-          break;
-        }
-    }
+    const sensor_msgs::ImageConstPtr rgb = findByStamp(rgb_cache_, msg.header.stamp);
     cv::Mat img;
     try {
       if (rgb) img = imageToBgr(*rgb, rgb_sub_.getTopic());
     } catch (const std::exception&) {
       // The colour image was already reported by the Screening nodelet; draw on grey instead.
     }
-    if (img.empty()) img = cv::Mat(msg.height, msg.width, CV_8UC3, cv::Scalar(64, 64, 64));
-    detection::drawBoxes(img, boxesFromMsg(msg.boxes));
-    int kept = 0, dropped = 0;
-    for (size_t i = 0; i < msg.keypoints.size(); ++i) {
-      const bool dyn = msg.dynamic[i] != 0;
-      (dyn ? dropped : kept)++;
-      const cv::Point p(cvRound(msg.keypoints[i].x), cvRound(msg.keypoints[i].y));
-      if (dyn)
-        cv::drawMarker(img, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 7, 1);
-      else
-        cv::circle(img, p, 3, cv::Scalar(0, 255, 0), 1);
-    }
-    const std::string text = std::string("tracking ") + stateName(res.state) + "  kept " +
-                             std::to_string(kept) + "  dropped " + std::to_string(dropped) +
-                             "  inliers " + std::to_string(res.inliers);
-    cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3);
-    cv::putText(img, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                cv::Scalar(255, 255, 255), 1);
+    img = drawDebugImage(img, msg, stateName(res.state), res.inliers);
     debug_pub_.publish(cv_bridge::CvImage(msg.header, sensor_msgs::image_encodings::BGR8, img).toImageMsg());
   }
 
@@ -349,72 +315,8 @@ class SlamNodelet : public nodelet::Nodelet {
       path_pub_.publish(path_);
     }
 
-    auto cloud = boost::make_shared<sensor_msgs::PointCloud2>();
-    const Pose T_map_world = pose_out_->worldInMap();
-    cloud->header.frame_id = pose_out_->mapFrame();
-    cloud->header.stamp = now;
-    sensor_msgs::PointCloud2Modifier mod(*cloud);
-    mod.setPointCloud2FieldsByString(1, "xyz");
-    mod.resize(snap.points.size());
-    sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
-    for (const auto& p : snap.points) {
-      const Eigen::Vector3d q = T_map_world * p;
-      *x = static_cast<float>(q.x());
-      *y = static_cast<float>(q.y());
-      *z = static_cast<float>(q.z());
-      ++x, ++y, ++z;
-    }
-    cloud_pub_.publish(cloud);
-
-    auto markers = boost::make_shared<visualization_msgs::MarkerArray>();
-    visualization_msgs::Marker kf, edges;
-    kf.header.frame_id = edges.header.frame_id = pose_out_->mapFrame();
-    kf.header.stamp = edges.header.stamp = now;
-    kf.ns = "keyframes";
-    edges.ns = "covisibility";
-    kf.type = edges.type = visualization_msgs::Marker::LINE_LIST;
-    kf.action = edges.action = visualization_msgs::Marker::ADD;
-    kf.pose.orientation.w = edges.pose.orientation.w = 1.0;
-    kf.scale.x = 0.005;
-    edges.scale.x = 0.002;
-    kf.color.b = 1.0f;
-    kf.color.a = 1.0f;
-    edges.color.g = 0.8f;
-    edges.color.a = 0.6f;
-    auto pt = [](const Eigen::Vector3d& v) {
-      geometry_msgs::Point p;
-      p.x = v.x();
-      p.y = v.y();
-      p.z = v.z();
-      return p;
-    };
-    // A small camera frustum per keyframe (apex + 4 image corners at 5 cm).
-    const double w = 0.04, h = 0.03, d = 0.05;
-    const Eigen::Vector3d corners[4] = {{-w, -h, d}, {w, -h, d}, {w, h, d}, {-w, h, d}};
-    std::vector<Eigen::Vector3d> centres;
-    for (const auto& k : snap.keyframes) {
-      const Pose T = T_map_world * k.T_wc;
-      const Eigen::Vector3d o = T.translation();
-      centres.push_back(o);
-      for (int i = 0; i < 4; ++i) {
-        kf.points.push_back(pt(o));
-        kf.points.push_back(pt(T * corners[i]));
-        kf.points.push_back(pt(T * corners[i]));
-        kf.points.push_back(pt(T * corners[(i + 1) % 4]));
-      }
-    }
-    for (const auto& e : snap.covisibility_edges) {
-      if (e.first < 0 || e.second < 0 || e.first >= static_cast<int>(centres.size()) ||
-          e.second >= static_cast<int>(centres.size()))
-        continue;
-      edges.points.push_back(pt(centres[e.first]));
-      edges.points.push_back(pt(centres[e.second]));
-    }
-    if (kf.points.empty()) kf.action = visualization_msgs::Marker::DELETE;
-    if (edges.points.empty()) edges.action = visualization_msgs::Marker::DELETE;
-    markers->markers.push_back(kf);
-    markers->markers.push_back(edges);
-    marker_pub_.publish(markers);
+    cloud_pub_.publish(mapPointCloud(snap, pose_out_->worldInMap(), pose_out_->mapFrame(), now));
+    marker_pub_.publish(keyframeMarkers(snap, pose_out_->worldInMap(), pose_out_->mapFrame(), now));
   }
 
   void publishDenseMap() {
@@ -423,53 +325,92 @@ class SlamNodelet : public nodelet::Nodelet {
     if (dense) dense_pub_.publish(*dense, pose_out_->worldInMap(), pose_out_->mapFrame(), ::ros::Time::now());
   }
 
-  void publishDiagnostics() {
-    diagnostic_msgs::DiagnosticStatus st;
-    st.name = getName() + ": tracking";
-    st.hardware_id = "yolo_slam";
-    Summary s;
+  // /diagnostics through diagnostic_updater: the counters below and the pose rate, sent on a
+  // wall timer so they keep coming while a bag is paused.
+  void startDiagnostics(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh) {
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("yolo_slam");
+    updater_->add("tracking", this, &SlamNodelet::fillDiagnostics);
+    pose_rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+        diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_), "published pose rate");
+    updater_->add(*pose_rate_);
+    diag_timer_ = nh.createWallTimer(::ros::WallDuration(kDiagnosticsPeriodS),
+                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+  }
+
+  // Caller holds system_mutex_.
+  void recordTimes(double track_ms, double conversion_ms) {
+    for (auto& [v, ms] : {std::pair<std::vector<double>*, double>{&track_ms_, track_ms}, {&conversion_ms_, conversion_ms}}) {
+      v->push_back(ms);
+      if (v->size() > kTimingWindow) v->erase(v->begin(), v->begin() + kTimingWindow / 2);
+    }
+  }
+
+  void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
+    Summary track, conversion, local_mapping;
+    size_t keyframes = 0, map_points = 0;
     {
       std::lock_guard<std::mutex> lock(system_mutex_);
-      s = summarize(track_ms_);
+      track = summarize(track_ms_);
+      conversion = summarize(conversion_ms_);
+      if (system_) {
+        const slam::SystemStats ss = system_->stats();
+        local_mapping = summarize(ss.local_mapping_ms);
+        keyframes = ss.keyframes;
+        map_points = ss.map_points;
+      }
     }
-    const size_t dropped = dropped_, rejected = rejected_;
-    const slam::TrackingState state = last_state_;
-    st.level = dropped + rejected + out_of_order_ > 0 || state == slam::TrackingState::Lost
-                   ? diagnostic_msgs::DiagnosticStatus::WARN
-                   : diagnostic_msgs::DiagnosticStatus::OK;
-    st.message = std::string("tracking ") + stateName(state) + ", " + std::to_string(dropped) +
-                 " dropped, " + std::to_string(rejected) + " rejected";
-    auto kv = [&](const std::string& k, size_t v) {
-      diagnostic_msgs::KeyValue p;
-      p.key = k;
-      p.value = std::to_string(v);
-      st.values.push_back(p);
-    };
-    kv("received", received_);
-    kv("tracked", tracked_);
-    kv("not_tracked", not_tracked_);
-    kv("dropped", dropped);
-    kv("rejected_bad_input", rejected);
-    kv("out_of_order", out_of_order_);
-    diagnostic_msgs::KeyValue m;
-    m.key = "track_median_ms";
-    m.value = std::to_string(s.median);
-    st.values.push_back(m);
     Summary lat;
     {
       std::lock_guard<std::mutex> lock(latency_mutex_);
       lat = summarize(latency_ms_);
     }
-    for (const auto& kvp : {std::make_pair("latency_median_ms", lat.median), std::make_pair("latency_p95_ms", lat.p95)}) {
-      diagnostic_msgs::KeyValue l;
-      l.key = kvp.first;
-      l.value = std::to_string(kvp.second);
-      st.values.push_back(l);
+    const size_t dropped = dropped_, rejected = rejected_;
+    const slam::TrackingState state = last_state_;
+    const bool warn = dropped + rejected + out_of_order_ > 0 || state == slam::TrackingState::Lost;
+    st.summaryf(warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
+                "tracking %s, %zu dropped, %zu rejected", stateName(state), dropped, rejected);
+    st.add("received", received_.load());
+    st.add("tracked", tracked_.load());
+    st.add("not_tracked", not_tracked_.load());
+    st.add("dropped", dropped);
+    st.add("rejected_bad_input", rejected);
+    st.add("out_of_order", out_of_order_.load());
+    st.add("track_median_ms", track.median);
+    st.add("message_conversion_median_ms", conversion.median);
+    st.add("local_mapping_median_ms", local_mapping.median);
+    st.add("keyframes", keyframes);
+    st.add("map_points", map_points);
+    st.add("latency_median_ms", lat.median);
+    st.add("latency_p95_ms", lat.p95);
+  }
+
+  // Live parameters (cfg/Slam.cfg). The first call comes from setCallback, with the values of
+  // ~localization_mode, ~map_publish_period and ~debug_image.
+  void startReconfigure(const ::ros::NodeHandle& pnh) {
+    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
+    reconfigure_->setCallback([this](SlamConfig& c, uint32_t) { onReconfigure(c); });
+  }
+
+  // Called with reconfigure_mutex_ held (by the server).
+  void onReconfigure(const SlamConfig& c) {
+    config_ = c;
+    debug_image_ = c.debug_image;
+    if (c.map_publish_period > 0) {
+      map_timer_.setPeriod(::ros::WallDuration(c.map_publish_period));
+      map_timer_.start();
+    } else {
+      map_timer_.stop();
     }
-    diagnostic_msgs::DiagnosticArray arr;
-    arr.header.stamp = ::ros::Time::now();
-    arr.status.push_back(st);
-    diag_pub_.publish(arr);
+    setLocalizationOnly(c.localization_mode);
+  }
+
+  void setLocalizationOnly(bool on) {
+    std::lock_guard<std::mutex> lock(system_mutex_);
+    if (on == localization_only_) return;
+    localization_only_ = on;
+    if (system_) system_->setLocalizationOnly(on);
+    NODELET_INFO("Slam: %s", on ? "localization only: mapping paused" : "mapping resumed");
   }
 
   bool onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -632,42 +573,60 @@ class SlamNodelet : public nodelet::Nodelet {
   }
 
   bool onLocalization(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
-    std::lock_guard<std::mutex> lock(system_mutex_);
-    localization_only_ = req.data;
-    if (system_) system_->setLocalizationOnly(req.data);
+    setLocalizationOnly(req.data);
+    SlamConfig c;
+    {
+      boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
+      config_.localization_mode = req.data;
+      c = config_;
+    }
+    reconfigure_->updateConfig(c);  // rqt_reconfigure shows the service's choice
     res.success = true;
     res.message = req.data ? "localization only: mapping paused" : "mapping resumed";
-    NODELET_INFO("Slam: %s", res.message.c_str());
     return true;
   }
+
+  using ReconfigureServer = dynamic_reconfigure::Server<SlamConfig>;
+  static constexpr double kWarnPeriodS = 2.0;  // per-frame warnings at most this often
+  static constexpr double kDiagnosticsPeriodS = 1.0;
+  static constexpr double kDefaultMinRateHz = 5.0;  // pose rate diagnostics warn outside this band
+  static constexpr double kDefaultMaxRateHz = 60.0;
+  static constexpr uint32_t kImageQueue = 30;
 
   // Parameters (const after onInit).
   bool use_camera_info_ = true;
   ErrorThrottle throttle_;
-  bool debug_image_ = true, dense_map_ = false;
-  double map_period_ = 1.0, dense_period_ = 2.0;
+  bool dense_map_ = false;
+  double dense_period_ = 2.0;
+  double min_rate_hz_ = kDefaultMinRateHz, max_rate_hz_ = kDefaultMaxRateHz;  // read by pose_rate_
   std::string trajectory_path_, map_file_, octomap_path_;
   Config settings_;
   std::shared_ptr<const vocabulary::Vocabulary> vocabulary_;
 
   CameraSource camera_;  // camera_info callback vs frame callback: locks inside
 
-  // Guards system_, localization_only_ and track_ms_ (frame callback, map timer, services,
+  // Guards system_, localization_only_, track_ms_ and conversion_ms_ (frame callback, map timer, services,
   // diagnostics). Lock order: system_mutex_ before path_mutex_ (never the reverse).
   std::mutex system_mutex_;
   std::unique_ptr<slam::System> system_;
   bool localization_only_ = false;
   std::string pending_map_;  // loaded when the System starts (set before the first frame)
-  std::vector<double> track_ms_;
+  static constexpr size_t kTimingWindow = 1000;  // timing samples kept for diagnostics
+  std::vector<double> track_ms_, conversion_ms_;
 
   std::mutex path_mutex_;  // guards path_ (frame callback vs map timer vs reset)
   nav_msgs::Path path_;
 
-  // Guards recent_rgb_ and recent_depth_ (image callbacks vs frame callback); taken alone or
-  // after system_mutex_.
-  static constexpr size_t kRecentImages = 60;
-  std::mutex rgb_mutex_;
-  std::deque<sensor_msgs::ImageConstPtr> recent_rgb_, recent_depth_;
+  // Live parameters: written by the reconfigure callback, read by the frame callback.
+  std::atomic<bool> debug_image_{true};
+  boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure's lock; also guards config_
+  SlamConfig config_;
+  std::unique_ptr<ReconfigureServer> reconfigure_;
+
+  // The last kRecentImages colour and depth images by stamp; message_filters::Cache locks inside.
+  static constexpr unsigned kRecentImages = 60;
+  message_filters::Subscriber<sensor_msgs::Image> rgb_sub_, depth_sub_;
+  message_filters::Cache<sensor_msgs::Image> rgb_cache_{kRecentImages}, depth_cache_{kRecentImages};
 
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
@@ -682,12 +641,18 @@ class SlamNodelet : public nodelet::Nodelet {
   std::vector<double> latency_ms_;
   std::atomic<slam::TrackingState> last_state_{slam::TrackingState::NotInitialized};
 
-  ::ros::Subscriber frame_sub_, info_sub_, rgb_sub_, depth_sub_;
+  ::ros::Subscriber frame_sub_, info_sub_;
   // Pose, odometry and tf. Used by the frame callback; the map timer reads its frames and
   // mount only once system_ exists, i.e. after the frame callback resolved the mount (the
   // mount is written once, before system_ is created under system_mutex_).
   std::unique_ptr<PoseOutput> pose_out_;
-  ::ros::Publisher path_pub_, cloud_pub_, marker_pub_, debug_pub_, diag_pub_;
+  ::ros::Publisher path_pub_, cloud_pub_, marker_pub_;
+  std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  image_transport::Publisher debug_pub_;
+  // Diagnostics: fillDiagnostics reads the counters (atomics or under their mutexes);
+  // FrequencyStatus locks inside.
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> pose_rate_;
   ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_, save_octomap_srv_;
   ::ros::WallTimer map_timer_, diag_timer_, dense_timer_;
   DenseMapPublisher dense_pub_;

@@ -1,5 +1,6 @@
 #include "yolo_slam/slam/loop_closing.h"
 
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/optimization/bundle_adjustment.h"
 #include "yolo_slam/optimization/pose_graph.h"
 #include "yolo_slam/optimization/pose_optimizer.h"
@@ -442,8 +443,8 @@ bool LoopClosing::verifyCandidate(const KeyFramePtr& kf, const KeyFramePtr& cand
   if (final_inliers < opt_.min_matches) return false;
   double corr_m = 0, corr_deg = 0;
   if (!withinDriftBound(*kf, *cand, F.T_cw, corr_m, corr_deg)) return false;
-  std::fprintf(stderr, "loop: keyframe %ld matches keyframe %ld (%d BoW, %d RANSAC, %d final), "
-               "correction %.3f m %.2f deg\n", kf->id, cand->id, static_cast<int>(n_bow), fit.inliers,
+  log::info("loop: keyframe %ld matches keyframe %ld (%d BoW, %d RANSAC, %d final), "
+               "correction %.3f m %.2f deg", kf->id, cand->id, static_cast<int>(n_bow), fit.inliers,
                final_inliers, corr_m, corr_deg);
   matched_kf_ = cand;
   T_cw_corrected_ = F.T_cw;
@@ -461,8 +462,8 @@ bool LoopClosing::withinDriftBound(const KeyFrame& kf, const KeyFrame& cand, con
   corr_deg = rotationAngle(D.linear()) * 180 / M_PI;
   const bool too_large = corr_m > opt_.max_correction_m || corr_deg > opt_.max_correction_deg;
   if (!too_large) return true;
-  std::fprintf(stderr, "loop: keyframe %ld vs %ld rejected: correction %.3f m %.1f deg above the "
-               "drift bound (LoopClosing.maxCorrectionM/Deg)\n", kf.id, cand.id, corr_m, corr_deg);
+  log::info("loop: keyframe %ld vs %ld rejected: correction %.3f m %.1f deg above the "
+               "drift bound (LoopClosing.maxCorrectionM/Deg)", kf.id, cand.id, corr_m, corr_deg);
   return false;
 }
 
@@ -636,7 +637,7 @@ std::map<long, Pose> LoopClosing::optimizeEssentialGraph(const KeyFramePtr& kf, 
   try {
     optimization::optimizePoseGraph(T_wc, edges, fixed, opt_.pose_graph_iterations);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "warning: loop %ld-%ld: essential graph not optimised: %s\n", kf->id,
+    log::warn("loop %ld-%ld: essential graph not optimised: %s", kf->id,
                  loop_kf->id, e.what());
     T_wc = T_wc_start;
   }
@@ -697,7 +698,7 @@ void LoopClosing::runGlobalBA(long loop_kf_id) {
   try {
     res = optimization::globalBundleAdjustment(cam_, problem, opt_.global_ba_iterations, gba_stop_);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "warning: global BA after loop at keyframe %ld failed: %s\n", loop_kf_id, e.what());
+    log::warn("global BA after loop at keyframe %ld failed: %s", loop_kf_id, e.what());
     gba_running_.store(false);
     return;
   }

@@ -3,6 +3,7 @@
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/json.h"
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/slam/keyframe.h"
@@ -112,13 +113,13 @@ namespace {
 cv::Mat usableDepth(const cv::Mat& depth, const cv::Mat& image, double stamp) {
   if (depth.empty() || image.empty()) return cv::Mat();
   if (depth.type() != CV_32FC1) {
-    std::fprintf(stderr, "warning: frame %.6f: depth image of type %s, need CV_32FC1 metres (decode it "
-                 "with io::decodeDepth); frame tracked without depth\n", stamp, cv::typeToString(depth.type()).c_str());
+    log::warn("frame %.6f: depth image of type %s, need CV_32FC1 metres (decode it "
+                 "with io::decodeDepth); frame tracked without depth", stamp, cv::typeToString(depth.type()).c_str());
     return cv::Mat();
   }
   if (depth.size() != image.size()) {
-    std::fprintf(stderr, "warning: frame %.6f: the depth image is %dx%d, the colour image %dx%d; "
-                 "register the depth to the colour camera at its size; frame tracked without depth\n",
+    log::warn("frame %.6f: the depth image is %dx%d, the colour image %dx%d; "
+                 "register the depth to the colour camera at its size; frame tracked without depth",
                  stamp, depth.cols, depth.rows, image.cols, image.rows);
     return cv::Mat();
   }
@@ -147,7 +148,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   try {
     fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_, detector_ran);
   } catch (const Error& e) {
-    std::fprintf(stderr, "warning: frame %.6f: %s; frame reported lost\n", stamp, e.what());
+    log::warn("frame %.6f: %s; frame reported lost", stamp, e.what());
     fe = frontend::FrontEndResult();
     fe.frame.stamp = stamp;
   }
@@ -245,7 +246,7 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
     else ++stats_.lost;
   }
   if (reset_requested) {
-    std::fprintf(stderr, "warning: frame %.6f: lost for long with a small map; map reset\n", frame.stamp);
+    log::warn("frame %.6f: lost for long with a small map; map reset", frame.stamp);
     resetInternal(true);
   } else if (run_mode_ == RunMode::Sequential) {
     runBackEndInline();

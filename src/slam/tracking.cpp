@@ -1,5 +1,6 @@
 #include "yolo_slam/slam/tracking.h"
 
+#include "yolo_slam/common/log.h"
 #include "yolo_slam/optimization/pose_optimizer.h"
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/local_mapping.h"
@@ -138,7 +139,7 @@ void Tracking::checkTimestamp(const Frame& F) {
     const double dt = F.stamp - last_stamp_;
     if (!(dt > 0) || dt > opt_.max_stamp_gap) {
       if (has_velocity_)
-        std::fprintf(stderr, "warning: frame %.6f: timestamp jump of %.3f s; motion model reset\n",
+        log::warn("frame %.6f: timestamp jump of %.3f s; motion model reset",
                      F.stamp, dt);
       has_velocity_ = false;
     }

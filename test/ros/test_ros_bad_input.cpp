@@ -14,6 +14,7 @@
 #include <functional>
 
 #include "rosout_watch.h"
+#include "test_frames.h"
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/KeypointFrame.h"
 
@@ -22,18 +23,6 @@ using rosgraph_msgs::Log;
 
 namespace {
 
-sensor_msgs::ImagePtr toImage(const cv::Mat& m, const std::string& encoding, const ros::Time& t) {
-  auto img = boost::make_shared<sensor_msgs::Image>();
-  img->header.stamp = t;
-  img->header.frame_id = "camera_rgb_optical_frame";
-  img->width = m.cols;
-  img->height = m.rows;
-  img->encoding = encoding;
-  img->step = static_cast<uint32_t>(m.cols * m.elemSize());
-  img->data.assign(m.data, m.data + m.total() * m.elemSize());
-  return img;
-}
-
 class BadInput : public ::testing::Test {
  protected:
   // The nodelets share one manager process: a topic counts one connection for all of them, so
@@ -41,8 +30,8 @@ class BadInput : public ::testing::Test {
   static void SetUpTestSuite() {
     nh_ = new ros::NodeHandle;
     watch_ = new RosoutWatch(*nh_);
-    rgb_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/rgb/image_color", 10);
-    depth_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/depth/image", 10);
+    rgb_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/rgb/image_raw", 10);
+    depth_pub_ = nh_->advertise<sensor_msgs::Image>("/camera/depth_registered/image_raw", 10);
     info_pub_ = nh_->advertise<sensor_msgs::CameraInfo>("/camera/rgb/camera_info", 1, true);
     kf_pub_ = nh_->advertise<yolo_slam::KeypointFrame>("/yolo_slam/keypoint_frame", 10);
     boxes_sub_ = nh_->subscribe<yolo_slam::BoundingBoxes>(
@@ -137,13 +126,7 @@ TEST_F(BadInput, MissingCameraInfoIsReportedByScreeningAndSlam) {
 }
 
 TEST_F(BadInput, ScreeningRejectsWrongDepthEncodingAndEmptyDepth) {
-  sensor_msgs::CameraInfo info;
-  info.header.frame_id = "camera_rgb_optical_frame";
-  info.width = 640;
-  info.height = 480;
-  info.K = {535.4, 0, 320.1, 0, 539.2, 247.6, 0, 0, 1};
-  info.distortion_model = "plumb_bob";
-  info.D = {0, 0, 0, 0, 0};
+  const sensor_msgs::CameraInfo info = tum3CameraInfo();
   info_pub_.publish(info);
   ros::WallDuration(0.5).sleep();
   EXPECT_TRUE(sendUntil(
@@ -151,14 +134,14 @@ TEST_F(BadInput, ScreeningRejectsWrongDepthEncodingAndEmptyDepth) {
         rgb_pub_.publish(toImage(rgb_, enc::BGR8, t));
         depth_pub_.publish(toImage(rgb_, enc::RGB8, t));
       },
-      [] { return logged("unsupported depth encoding 'rgb8' on /camera/depth/image"); }, 15))
+      [] { return logged("unsupported depth encoding 'rgb8' on /camera/depth_registered/image_raw"); }, 15))
       << watch_->dump();
   EXPECT_TRUE(sendUntil(
       [](const ros::Time& t) {
         rgb_pub_.publish(toImage(rgb_, enc::BGR8, t));
         depth_pub_.publish(toImage(cv::Mat(0, 0, CV_32F), enc::TYPE_32FC1, t));
       },
-      [] { return logged("empty image on /camera/depth/image"); }, 15))
+      [] { return logged("empty image on /camera/depth_registered/image_raw"); }, 15))
       << watch_->dump();
   // Unregistered depth (the depth camera's own frame) is refused, not screened pixel for pixel.
   EXPECT_TRUE(sendUntil(
@@ -194,6 +177,16 @@ TEST_F(BadInput, GraphStillRunsAfterwards) {
   EXPECT_TRUE(sendUntil([](const ros::Time&) {}, [] { return frames_ >= 3 && poses_ >= 1; }, 30))
       << "keypoint frames " << frames_ << ", poses " << poses_ << "\n" << watch_->dump();
   EXPECT_EQ(watch_->count(Log::FATAL, ""), 0u);
+}
+
+// The core library's own warnings (here: tracking's motion-model reset on a stamp gap) reach
+// /rosout through the log sink the nodelets install, not the manager's stderr.
+TEST_F(BadInput, CoreWarningsReachRosout) {
+  constexpr double kGapS = 5.0;  // above Tracking.maxStampGap (1 s)
+  ASSERT_TRUE(sendUntil([](const ros::Time&) {}, [] { return poses_ >= 3; }, 30)) << watch_->dump();
+  EXPECT_TRUE(sendUntil([](const ros::Time&) { t_ += kGapS; },
+                        [] { return watch_->count(Log::WARN, "timestamp jump of") > 0; }, 20))
+      << watch_->dump();
 }
 
 }  // namespace

@@ -200,6 +200,43 @@ TEST(Conversions, CameraInfo) {
   EXPECT_THROW(ros1::cameraFromInfo(info, base, "t"), Error);
 }
 
+// Rectified images (image_proc's image_rect) are already undistorted: the projection matrix P
+// holds their intrinsics, and D must not be applied a second time.
+TEST(Conversions, CameraInfoRectifiedUsesP) {
+  sensor_msgs::CameraInfo info;
+  info.width = 320;
+  info.height = 240;
+  info.K = {300, 0, 160, 0, 310, 120, 0, 0, 1};
+  info.P = {290, 0, 158, 0, 0, 295, 118, 0, 0, 0, 1, 0};
+  info.distortion_model = "plumb_bob";
+  info.D = {0.1, -0.2, 0.001, 0.002, 0.05};
+  CameraModel base;
+  const CameraModel raw = ros1::cameraFromInfo(info, base, "t", false);
+  EXPECT_DOUBLE_EQ(raw.fx, 300);
+  EXPECT_DOUBLE_EQ(raw.cx, 160);
+  EXPECT_TRUE(raw.hasDistortion());
+  const CameraModel rect = ros1::cameraFromInfo(info, base, "t", true);
+  EXPECT_DOUBLE_EQ(rect.fx, 290);
+  EXPECT_DOUBLE_EQ(rect.fy, 295);
+  EXPECT_DOUBLE_EQ(rect.cx, 158);
+  EXPECT_DOUBLE_EQ(rect.cy, 118);
+  EXPECT_FALSE(rect.hasDistortion());
+  EXPECT_EQ(rect.width, 320);
+  EXPECT_NEAR(rect.baseline(), base.baseline(), 1e-12);
+  info.P.fill(0);
+  EXPECT_THROW(ros1::cameraFromInfo(info, base, "t", true), Error);
+  EXPECT_NO_THROW(ros1::cameraFromInfo(info, base, "t", false));
+}
+
+TEST(Conversions, RectifiedParameter) {
+  using ros1::Rectified;
+  EXPECT_TRUE(ros1::isRectified(ros1::parseRectified("auto"), "/camera/rgb/image_rect_color"));
+  EXPECT_FALSE(ros1::isRectified(ros1::parseRectified("auto"), "/camera/rgb/image_raw"));
+  EXPECT_TRUE(ros1::isRectified(ros1::parseRectified("true"), "/camera/rgb/image_raw"));
+  EXPECT_FALSE(ros1::isRectified(ros1::parseRectified("false"), "/camera/rgb/image_rect"));
+  EXPECT_THROW(ros1::parseRectified("yes"), Error);
+}
+
 TEST(Conversions, Poses) {
   const Pose T = makePose(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
                           Eigen::Vector3d(1, -2, 3));

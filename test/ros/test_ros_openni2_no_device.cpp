@@ -4,6 +4,8 @@
 #include <ros/master.h>
 #include <ros/ros.h>
 
+#include <map>
+
 #include "rosout_watch.h"
 
 TEST(OpenNI2Camera, NoDeviceLogsErrorAndRetries) {
@@ -17,9 +19,14 @@ TEST(OpenNI2Camera, NoDeviceLogsErrorAndRetries) {
   // Still alive: the manager keeps the camera topics advertised.
   ros::master::V_TopicInfo topics;
   ASSERT_TRUE(ros::master::getTopics(topics));
-  bool rgb = false;
-  for (const auto& t : topics) rgb = rgb || t.name == "/camera/rgb/image_color";
-  EXPECT_TRUE(rgb);
+  // openni2_launch's names and types.
+  std::map<std::string, std::string> advertised;
+  for (const auto& t : topics) advertised[t.name] = t.datatype;
+  EXPECT_EQ(advertised["/camera/rgb/image_raw"], "sensor_msgs/Image");
+  EXPECT_EQ(advertised["/camera/rgb/camera_info"], "sensor_msgs/CameraInfo");
+  EXPECT_EQ(advertised["/camera/depth_registered/image_raw"], "sensor_msgs/Image");
+  EXPECT_EQ(advertised["/camera/depth_registered/image"], "sensor_msgs/Image");
+  EXPECT_EQ(advertised["/camera/depth_registered/camera_info"], "sensor_msgs/CameraInfo");
   std::vector<std::string> nodes;
   ASSERT_TRUE(ros::master::getNodes(nodes));
   EXPECT_NE(std::find(nodes.begin(), nodes.end(), "/camera_manager"), nodes.end());
@@ -29,6 +36,13 @@ TEST(OpenNI2Camera, MissingRecordingNamesTheFile) {
   ros::NodeHandle nh;
   RosoutWatch watch(nh);
   ASSERT_TRUE(watch.waitFor(rosgraph_msgs::Log::ERROR, "/nonexistent/recording.oni", 1, 20.0))
+      << watch.dump();
+}
+
+TEST(OpenNI2Camera, MissingNthDeviceSaysHowManyThereAre) {
+  ros::NodeHandle nh;
+  RosoutWatch watch(nh);
+  ASSERT_TRUE(watch.waitFor(rosgraph_msgs::Log::ERROR, "no OpenNI2 device #2 (0 connected)", 1, 20.0))
       << watch.dump();
 }
 

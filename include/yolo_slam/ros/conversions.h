@@ -48,11 +48,19 @@ cv::Mat imageView(const sensor_msgs::Image& msg, const std::string& topic, bool&
 cv::Mat depthToMetres(const sensor_msgs::Image& msg, const std::string& topic,
                       double factor_16u = 1000.0);
 
-// Camera model: intrinsics, distortion (plumb_bob / rational_polynomial first 5) and size from
-// a CameraInfo; bf, ThDepth and the rest from `base`. Throws Error if K is all zeros or the
-// size is 0.
+// Camera model from a CameraInfo (through image_geometry::PinholeCameraModel): for raw images
+// K and the distortion (plumb_bob / rational_polynomial first 5), for rectified images
+// (image_proc's image_rect*) P and no distortion, so they are not undistorted twice; size from
+// the CameraInfo; bf, ThDepth and the rest from `base`. Throws Error if K (or, rectified, P) is
+// all zeros, an entry is not finite, the principal point is outside the image or the size is 0.
 CameraModel cameraFromInfo(const sensor_msgs::CameraInfo& info, const CameraModel& base,
-                           const std::string& topic);
+                           const std::string& topic, bool rectified = false);
+
+// The nodelets' ~rectified parameter: auto (rectified when the image topic contains
+// "image_rect"), true or false. parseRectified throws Error on another value.
+enum class Rectified { Auto, Yes, No };
+Rectified parseRectified(const std::string& value);
+bool isRectified(Rectified mode, const std::string& image_topic);
 
 // Poses.
 geometry_msgs::Pose poseToMsg(const Pose& T);
