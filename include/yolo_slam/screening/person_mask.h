@@ -1,5 +1,5 @@
 #pragma once
-// Screening beyond the boxes (issue 23): the pixels of each person found in a box, grown by
+// Screening beyond the boxes: the pixels of each person found in a box, grown by
 // depth continuity from the person's keypoints over the depth image, a little past the box.
 // Two rules read the mask: keypoints with depth outside every box that lie on it are the
 // person's (a detector box cuts off an arm, a head or a carried object), and keypoints without
