@@ -110,6 +110,16 @@ class CameraSource {
     std::lock_guard<std::mutex> lock(mutex_);
     cam_ = cam;
   }
+  // True for a frame (image stamp) that comes before any camera_info but within
+  // kFirstInfoGraceS of the first frame: a driver or bag publishes both at once and the
+  // subscriptions race, so such a frame is skipped quietly rather than reported as bad input.
+  bool awaitingFirstInfo(const ::ros::Time& stamp) {
+    if (!use_camera_info_) return false;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (cam_) return false;
+    if (first_stamp_.isZero() || stamp < first_stamp_) first_stamp_ = stamp;
+    return (stamp - first_stamp_).toSec() < kFirstInfoGraceS;
+  }
   // Throws Error when camera_info is wanted and none has arrived on `topic` yet.
   CameraModel get(const std::string& topic) const {
     if (!use_camera_info_) return base_;
@@ -125,8 +135,10 @@ class CameraSource {
   CameraModel base_;             // const after configure()
   bool use_camera_info_ = true;  // const after configure()
   bool rectified_ = false;       // const after configure()
-  mutable std::mutex mutex_;     // guards cam_
+  static constexpr double kFirstInfoGraceS = 1.0;
+  mutable std::mutex mutex_;     // guards cam_ and first_stamp_
   std::optional<CameraModel> cam_;
+  ::ros::Time first_stamp_;      // the first frame asked about before any camera_info
 };
 
 }  // namespace ros1

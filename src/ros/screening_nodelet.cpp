@@ -244,6 +244,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
       NODELET_WARN_THROTTLE(kWarnPeriodS, "Screening: the synchroniser dropped %zu colour frame(s) before %.3f "
                             "(%zu in total); raise ~queue_size or play the bag slower", dropped_now,
                             rgb->header.stamp.toSec(), dropped_.load());
+    if (camera_.awaitingFirstInfo(rgb->header.stamp)) {
+      ++awaiting_camera_info_;
+      return;
+    }
     try {
       Stopwatch sw;
       CameraModel cam = camera();
@@ -310,6 +314,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     st.add("published", published);
     st.add("dropped_by_sync", dropped);
     st.add("rejected_bad_input", rejected);
+    st.add("awaiting_camera_info", awaiting_camera_info_.load());
     st.add("median_ms", s.median);
     st.add("extraction_median_ms", ext.median);
     st.add("screening_median_ms", scr.median);
@@ -348,6 +353,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
   // Frames not published because no detection had arrived yet (FrontEndResult::awaiting_detection),
   // and the stamp of the first frame (frame callback only).
   std::atomic<long> awaiting_detection_{0};
+  // Frames skipped because they came just before the first camera_info (CameraSource).
+  std::atomic<long> awaiting_camera_info_{0};
   ::ros::Time first_stamp_;
   ErrorThrottle throttle_;
   double depth_factor_16u_ = 1000.0;

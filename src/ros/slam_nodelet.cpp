@@ -224,6 +224,10 @@ class SlamNodelet : public nodelet::Nodelet {
       ++rejected_;
       return;
     }
+    if (camera_.awaitingFirstInfo(msg->header.stamp)) {
+      ++awaiting_camera_info_;
+      return;
+    }
     try {
       const CameraModel cam = camera();
       Stopwatch conversion;
@@ -375,6 +379,7 @@ class SlamNodelet : public nodelet::Nodelet {
     st.add("not_tracked", not_tracked_.load());
     st.add("dropped", dropped);
     st.add("rejected_bad_input", rejected);
+    st.add("awaiting_camera_info", awaiting_camera_info_.load());
     st.add("out_of_order", out_of_order_.load());
     st.add("track_median_ms", track.median);
     st.add("message_conversion_median_ms", conversion.median);
@@ -631,6 +636,7 @@ class SlamNodelet : public nodelet::Nodelet {
   // Frame callback counters (the subscription's callbacks are serialised); read by diagnostics.
   uint32_t last_index_ = 0;
   std::atomic<size_t> received_{0}, tracked_{0}, not_tracked_{0}, dropped_{0}, rejected_{0};
+  std::atomic<size_t> awaiting_camera_info_{0};  // frames just before the first camera_info
   // Stamp of the last frame let through (frame callback; reset stores -inf), and the frames
   // dropped for not being newer.
   std::atomic<double> last_stamp_{-std::numeric_limits<double>::infinity()};

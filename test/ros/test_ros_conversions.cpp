@@ -7,6 +7,7 @@
 
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/ros/conversions.h"
+#include "../../src/ros/nodelet_common.h"
 
 using namespace yolo_slam;
 namespace enc = sensor_msgs::image_encodings;
@@ -235,6 +236,28 @@ TEST(Conversions, RectifiedParameter) {
   EXPECT_TRUE(ros1::isRectified(ros1::parseRectified("true"), "/camera/rgb/image_raw"));
   EXPECT_FALSE(ros1::isRectified(ros1::parseRectified("false"), "/camera/rgb/image_rect"));
   EXPECT_THROW(ros1::parseRectified("yes"), Error);
+}
+
+// Frames before the first camera_info are skipped quietly for 1 s of stamps (start-up race of
+// the subscriptions), then reported; never once camera_info came, never without camera_info.
+TEST(CameraSource, FramesJustBeforeTheFirstCameraInfoAreAwaited) {
+  sensor_msgs::CameraInfo info;
+  info.width = 320;
+  info.height = 240;
+  info.K = {300, 0, 160, 0, 310, 120, 0, 0, 1};
+  ros1::CameraSource source;
+  source.configure(CameraModel(), true);
+  const ros::Time t0(100.0);
+  EXPECT_TRUE(source.awaitingFirstInfo(t0));
+  EXPECT_TRUE(source.awaitingFirstInfo(t0 + ros::Duration(0.9)));
+  EXPECT_FALSE(source.awaitingFirstInfo(t0 + ros::Duration(1.1)));
+  EXPECT_THROW(source.get("t"), Error);
+  source.update(info, "t");
+  EXPECT_FALSE(source.awaitingFirstInfo(t0 + ros::Duration(0.1)));
+  EXPECT_EQ(source.get("t").width, 320);
+  ros1::CameraSource from_settings;
+  from_settings.configure(CameraModel(), false);
+  EXPECT_FALSE(from_settings.awaitingFirstInfo(t0));
 }
 
 TEST(Conversions, Poses) {
