@@ -26,7 +26,6 @@ class DetectorNodelet : public nodelet::Nodelet {
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<DetectorConfig>;
   static constexpr double kStatsPeriodS = 10.0;
-  static constexpr double kDiagnosticsPeriodS = 1.0;
   static constexpr size_t kTimingWindow = 1000;  // detection times kept for the periodic log
 
   void onInit() override {
@@ -53,12 +52,8 @@ class DetectorNodelet : public nodelet::Nodelet {
                         ::ros::TransportHints().tcpNoDelay());
     stats_timer_ = nh.createWallTimer(::ros::WallDuration(kStatsPeriodS),
                                       [this](const ::ros::WallTimerEvent&) { logStats(); });
-    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
-    updater_->setHardwareID("yolo_slam");
-    updater_->add("detection", this, &DetectorNodelet::fillDiagnostics);
-    // Wall time: diagnostics keep coming while a bag's clock stands still.
-    diag_timer_ = nh.createWallTimer(::ros::WallDuration(kDiagnosticsPeriodS),
-                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+    diagnostics_.begin(nh, pnh, getName()).add("detection", this, &DetectorNodelet::fillDiagnostics);
+    diagnostics_.run(nh);
   }
 
   void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
@@ -188,9 +183,9 @@ class DetectorNodelet : public nodelet::Nodelet {
   std::unique_ptr<ReconfigureServer> reconfigure_;
   ::ros::Subscriber sub_;
   ::ros::Publisher pub_;
-  ::ros::WallTimer stats_timer_, diag_timer_;
+  ::ros::WallTimer stats_timer_;
   // /diagnostics: fillDiagnostics reads the counters under their mutexes.
-  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  NodeletDiagnostics diagnostics_;
   std::mutex stats_mutex_;  // guards frames_, rejected_, throttled_, ms_ (image callback vs stats timer)
   size_t frames_ = 0, rejected_ = 0, throttled_ = 0;
   std::vector<double> ms_;

@@ -1,7 +1,9 @@
 #pragma once
 // Helpers shared by the yolo_slam nodelets (not installed).
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -59,6 +61,28 @@ inline Config loadSettings(const ::ros::NodeHandle& pnh, std::string* path_out =
 inline CameraModel baseCamera(const Config& cfg) {
   return cfg.has("Camera.fx") ? CameraModel::load(cfg) : CameraModel();
 }
+
+// A nodelet's /diagnostics: a diagnostic_updater::Updater (hardware id yolo_slam) sent on a wall
+// timer, not Updater::update's ROS-time period, so diagnostics keep coming while a bag's clock
+// stands still. begin() in onInit, then add the tasks, then run(). The Updater locks inside.
+class NodeletDiagnostics {
+ public:
+  diagnostic_updater::Updater& begin(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh, const std::string& name) {
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, name);
+    updater_->setHardwareID("yolo_slam");
+    return *updater_;
+  }
+  void run(::ros::NodeHandle& nh) {
+    timer_ = nh.createWallTimer(::ros::WallDuration(kPeriodS),
+                                [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+  }
+  void stop() { timer_.stop(); }
+
+ private:
+  static constexpr double kPeriodS = 1.0;
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  ::ros::WallTimer timer_;
+};
 
 // Rate limit for per-frame errors that still shows every distinct problem at once: a message
 // is logged when its text differs from the previous one or `period` seconds have passed.

@@ -88,12 +88,12 @@ class ScreeningNodelet : public nodelet::Nodelet {
     }
 
     pub_ = nh.advertise<KeypointFrame>("yolo_slam/keypoint_frame", queue_size);
-    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
-    updater_->setHardwareID("yolo_slam");
-    updater_->add("frames", this, &ScreeningNodelet::fillDiagnostics);
+    diagnostic_updater::Updater& updater = diagnostics_.begin(nh, pnh, getName());
+    updater.add("frames", this, &ScreeningNodelet::fillDiagnostics);
     rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
         diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_), "published frame rate");
-    updater_->add(*rate_);
+    updater.add(*rate_);
+    diagnostics_.run(nh);
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
     rgb_sub_.subscribe(nh, kRgbTopic, queue_size);
@@ -118,10 +118,6 @@ class ScreeningNodelet : public nodelet::Nodelet {
       if (sync_min_period_ > 0) sync2_->setInterMessageLowerBound(::ros::Duration(sync_min_period_));
       sync2_->registerCallback(&ScreeningNodelet::onFrame2, this);
     }
-    // Wall time, not Updater::update's ROS-time period: diagnostics keep coming while a bag's
-    // clock stands still.
-    diag_timer_ = nh.createWallTimer(::ros::WallDuration(1.0),
-                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
     reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
     reconfigure_->setCallback([this](ScreeningConfig& c, uint32_t) { onReconfigure(c); });
   }
@@ -388,9 +384,8 @@ class ScreeningNodelet : public nodelet::Nodelet {
   double min_rate_hz_ = 5.0, max_rate_hz_ = 60.0;
   // Diagnostics on /diagnostics: the counters above (the fill callback reads them under
   // stats_mutex_ or as atomics) and the published frame rate (FrequencyStatus locks inside).
-  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  NodeletDiagnostics diagnostics_;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_;
-  ::ros::WallTimer diag_timer_;
 };
 
 }  // namespace ros1

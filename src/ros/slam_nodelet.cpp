@@ -64,7 +64,7 @@ class SlamNodelet : public nodelet::Nodelet {
  public:
   ~SlamNodelet() override {
     map_timer_.stop();
-    diag_timer_.stop();
+    diagnostics_.stop();
     dense_timer_.stop();
     std::lock_guard<std::mutex> lock(system_mutex_);
     if (!system_) return;
@@ -332,14 +332,12 @@ class SlamNodelet : public nodelet::Nodelet {
   // /diagnostics through diagnostic_updater: the counters below and the pose rate, sent on a
   // wall timer so they keep coming while a bag is paused.
   void startDiagnostics(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh) {
-    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
-    updater_->setHardwareID("yolo_slam");
-    updater_->add("tracking", this, &SlamNodelet::fillDiagnostics);
+    diagnostic_updater::Updater& updater = diagnostics_.begin(nh, pnh, getName());
+    updater.add("tracking", this, &SlamNodelet::fillDiagnostics);
     pose_rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
         diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_), "published pose rate");
-    updater_->add(*pose_rate_);
-    diag_timer_ = nh.createWallTimer(::ros::WallDuration(kDiagnosticsPeriodS),
-                                     [this](const ::ros::WallTimerEvent&) { updater_->force_update(); });
+    updater.add(*pose_rate_);
+    diagnostics_.run(nh);
   }
 
   // Caller holds system_mutex_.
@@ -351,18 +349,13 @@ class SlamNodelet : public nodelet::Nodelet {
   }
 
   void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
-    Summary track, conversion, local_mapping;
-    size_t keyframes = 0, map_points = 0;
+    Summary track, conversion;
+    slam::LiveCounts live;
     {
       std::lock_guard<std::mutex> lock(system_mutex_);
       track = summarize(track_ms_);
       conversion = summarize(conversion_ms_);
-      if (system_) {
-        const slam::SystemStats ss = system_->stats();
-        local_mapping = summarize(ss.local_mapping_ms);
-        keyframes = ss.keyframes;
-        map_points = ss.map_points;
-      }
+      if (system_) live = system_->liveCounts();
     }
     Summary lat;
     {
@@ -383,9 +376,9 @@ class SlamNodelet : public nodelet::Nodelet {
     st.add("out_of_order", out_of_order_.load());
     st.add("track_median_ms", track.median);
     st.add("message_conversion_median_ms", conversion.median);
-    st.add("local_mapping_median_ms", local_mapping.median);
-    st.add("keyframes", keyframes);
-    st.add("map_points", map_points);
+    st.add("local_mapping_median_ms", live.local_mapping_median_ms);
+    st.add("keyframes", live.keyframes);
+    st.add("map_points", live.map_points);
     st.add("latency_median_ms", lat.median);
     st.add("latency_p95_ms", lat.p95);
   }
@@ -593,7 +586,6 @@ class SlamNodelet : public nodelet::Nodelet {
 
   using ReconfigureServer = dynamic_reconfigure::Server<SlamConfig>;
   static constexpr double kWarnPeriodS = 2.0;  // per-frame warnings at most this often
-  static constexpr double kDiagnosticsPeriodS = 1.0;
   static constexpr double kDefaultMinRateHz = 5.0;  // pose rate diagnostics warn outside this band
   static constexpr double kDefaultMaxRateHz = 60.0;
   static constexpr uint32_t kImageQueue = 30;
@@ -657,10 +649,10 @@ class SlamNodelet : public nodelet::Nodelet {
   image_transport::Publisher debug_pub_;
   // Diagnostics: fillDiagnostics reads the counters (atomics or under their mutexes);
   // FrequencyStatus locks inside.
-  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  NodeletDiagnostics diagnostics_;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> pose_rate_;
   ::ros::ServiceServer reset_srv_, save_srv_, loc_srv_, save_map_srv_, load_map_srv_, save_octomap_srv_;
-  ::ros::WallTimer map_timer_, diag_timer_, dense_timer_;
+  ::ros::WallTimer map_timer_, dense_timer_;
   DenseMapPublisher dense_pub_;
 };
 

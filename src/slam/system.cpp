@@ -417,6 +417,17 @@ MapSnapshot System::mapSnapshot() const {
   return s;
 }
 
+LiveCounts System::liveCounts() const {
+  LiveCounts c;
+  {
+    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    c.keyframes = map_->numKeyFrames();
+    c.map_points = map_->numMapPoints();
+  }
+  c.local_mapping_median_ms = summarize(mapper_->timings()).median;
+  return c;
+}
+
 SystemStats System::stats() const {
   SystemStats s;
   {

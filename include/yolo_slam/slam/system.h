@@ -56,6 +56,12 @@ void to_json(Json& j, const BoxCounts& b);  // {"detected", "tracked"}
 
 // Counters, per-stage stats summed over the frames, and timing samples (milliseconds) for
 // stats.json.
+// What a monitor polls every second (the ROS diagnostics): cheap, no per-frame samples copied.
+struct LiveCounts {
+  size_t keyframes = 0, map_points = 0;
+  double local_mapping_median_ms = 0;  // per keyframe processed so far
+};
+
 struct SystemStats {
   size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0, resets = 0;
   size_t keyframes_culled = 0;
@@ -152,7 +158,8 @@ class System {
   Trajectory keyframeTrajectory() const;  // keyframes (also those of maps dropped by a reset)
   MapSnapshot mapSnapshot() const;
   std::string statsJson() const;
-  SystemStats stats() const;
+  SystemStats stats() const;  // copies every timing sample: for the end of a run
+  LiveCounts liveCounts() const;
 
   // Extra API for tools and tests.
   // Blocks until local mapping has processed every queued keyframe (or is paused). Sequential:
