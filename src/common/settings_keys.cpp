@@ -97,6 +97,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "ORBextractor.nFeatures",
       "ORBextractor.nLevels",
       "ORBextractor.scaleFactor",
+      "ORBextractor.threads",
       "Screening.boxDilation",
       "Screening.clusterMinFraction",
       "Screening.dilationDepthOnly",

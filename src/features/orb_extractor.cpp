@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <future>
 #include <numeric>
 #include <random>
 
@@ -31,6 +32,7 @@ const OptionTable<OrbOptions>& orbFields() {
       {"ORBextractor.iniThFAST", &O::ini_th_fast, Range::closed(1, 254)},
       {"ORBextractor.minThFAST", &O::min_th_fast, Range::closed(1, 254)},
       {"ORBextractor.dynamicBoostMax", &O::dynamic_boost_max, Range::closed(1, 4)},
+      {"ORBextractor.threads", &O::threads, Range::closed(1, O::kMaxThreads)},
   };
   return table;
 }
@@ -304,8 +306,101 @@ void briefDescriptor(const cv::Mat& blurred, const cv::KeyPoint& kp,
 }  // namespace
 
 // ------------------------------------------------------------------------------------------
-// Extraction
+// Extraction, one level at a time: pyramid, then per level FAST + quadtree + orientation and
+// blur + BRIEF. Levels are independent once the pyramid exists, so they can run on two threads
+// without changing the result.
 // ------------------------------------------------------------------------------------------
+
+std::vector<cv::Mat> OrbExtractor::buildPyramid(const cv::Mat& gray) const {
+  std::vector<cv::Mat> pyramid(options_.n_levels);
+  pyramid[0] = gray;
+  for (int level = 1; level < options_.n_levels; ++level) {
+    cv::Size sz(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
+                static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
+    if (sz.width <= 2 * kEdgeThreshold + 2 || sz.height <= 2 * kEdgeThreshold + 2) break;
+    cv::resize(pyramid[level - 1], pyramid[level], sz, 0, 0, cv::INTER_LINEAR);
+  }
+  return pyramid;
+}
+
+// FAST corners of one level's search area in area coordinates: one pass over the whole area at
+// the initial threshold gives exactly what per-cell calls would (minus duplicates from
+// overlapping cells); cells left empty are searched again with the fallback threshold, each on
+// its own window so that weak corners only fill holes.
+std::vector<cv::KeyPoint> OrbExtractor::fastCorners(const cv::Mat& area) const {
+  const int w = area.cols, h = area.rows;
+  const int n_cols = std::max(1, w / kCellSize), n_rows = std::max(1, h / kCellSize);
+  const int cell_w = (w + n_cols - 1) / n_cols, cell_h = (h + n_rows - 1) / n_rows;
+  std::vector<cv::KeyPoint> found;
+  cv::FAST(area, found, options_.ini_th_fast, true);
+  std::vector<uint8_t> occupied(n_cols * n_rows, 0);
+  for (const cv::KeyPoint& kp : found) {
+    int cx = std::min(n_cols - 1, static_cast<int>(kp.pt.x) / cell_w);
+    int cy = std::min(n_rows - 1, static_cast<int>(kp.pt.y) / cell_h);
+    occupied[cy * n_cols + cx] = 1;
+  }
+  std::vector<cv::KeyPoint> weak;
+  for (int cy = 0; cy < n_rows; ++cy) {
+    for (int cx = 0; cx < n_cols; ++cx) {
+      if (occupied[cy * n_cols + cx]) continue;
+      const int x0 = cx * cell_w, y0 = cy * cell_h;
+      const int x1 = std::min(w, x0 + cell_w), y1 = std::min(h, y0 + cell_h);
+      if (x1 <= x0 || y1 <= y0) continue;
+      // Window grown by FAST's radius so corners on the cell's own pixels are testable.
+      const int wx0 = std::max(0, x0 - kFastRadius), wy0 = std::max(0, y0 - kFastRadius);
+      const int wx1 = std::min(w, x1 + kFastRadius), wy1 = std::min(h, y1 + kFastRadius);
+      weak.clear();
+      cv::FAST(area(cv::Rect(wx0, wy0, wx1 - wx0, wy1 - wy0)), weak, options_.min_th_fast, true);
+      for (cv::KeyPoint kp : weak) {
+        kp.pt.x += wx0;
+        kp.pt.y += wy0;
+        if (kp.pt.x >= x0 && kp.pt.x < x1 && kp.pt.y >= y0 && kp.pt.y < y1) found.push_back(kp);
+      }
+    }
+  }
+  return found;
+}
+
+void OrbExtractor::extractLevel(const cv::Mat& img, int level, LevelFeatures& out) const {
+  out.keypoints.clear();
+  out.descriptors.release();
+  if (img.empty() || features_per_level_[level] <= 0) return;
+
+  // FAST search area as in ORB-SLAM2: 16 px margins plus FAST's own 3 px radius keep every
+  // keypoint >= 19 px from the border, far enough for the rotated 31 px patch and the blur.
+  const int min_x = kEdgeThreshold - kFastRadius, min_y = kEdgeThreshold - kFastRadius;
+  const int max_x = img.cols - kEdgeThreshold + kFastRadius;
+  const int max_y = img.rows - kEdgeThreshold + kFastRadius;
+  const int w = max_x - min_x, h = max_y - min_y;
+  if (w <= 2 * kFastRadius + 1 || h <= 2 * kFastRadius + 1) return;
+
+  std::vector<cv::KeyPoint> found = fastCorners(img(cv::Rect(min_x, min_y, w, h)));
+  for (cv::KeyPoint& kp : found) {
+    kp.pt.x += min_x;
+    kp.pt.y += min_y;
+  }
+  out.keypoints = distributeQuadtree(found, static_cast<float>(min_x), static_cast<float>(max_x),
+                                     static_cast<float>(min_y), static_cast<float>(max_y),
+                                     features_per_level_[level]);
+  if (out.keypoints.empty()) return;
+
+  // Descriptors on a smoothed image (7x7, sigma 2) as ORB-SLAM2: BRIEF is noise sensitive.
+  cv::Mat blurred;
+  cv::GaussianBlur(img, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+  const std::vector<cv::Point>& pattern = briefPattern();
+  const float size = static_cast<float>(kPatchSize * scale_factors_[level]);
+  const float scale = static_cast<float>(scale_factors_[level]);
+  out.descriptors.create(static_cast<int>(out.keypoints.size()), kDescriptorBytes, CV_8U);
+  for (size_t i = 0; i < out.keypoints.size(); ++i) {
+    cv::KeyPoint& kp = out.keypoints[i];
+    kp.octave = level;
+    kp.size = size;
+    kp.angle = icAngle(img, kp.pt, umax_);
+    kp.class_id = -1;
+    briefDescriptor(blurred, kp, pattern, out.descriptors.ptr<uint8_t>(static_cast<int>(i)));
+    if (level != 0) kp.pt *= scale;
+  }
+}
 
 void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints,
                            cv::Mat& descriptors) const {
@@ -315,100 +410,33 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
                 "; convert to grayscale first (features::buildFeatureFrame does)");
   }
   const int n_levels = options_.n_levels;
-  const std::vector<cv::Point>& pattern = briefPattern();
+  std::vector<LevelFeatures> levels(n_levels);
 
-  std::vector<std::vector<cv::KeyPoint>> level_kps(n_levels);
-  std::vector<cv::Mat> pyramid(n_levels);
-  int total = 0;
-
-  for (int level = 0; level < n_levels; ++level) {
-    if (level == 0) {
-      pyramid[0] = gray;
-    } else {
-      cv::Size sz(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
-                  static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
-      if (sz.width <= 2 * kEdgeThreshold + 2 || sz.height <= 2 * kEdgeThreshold + 2) break;
-      cv::resize(pyramid[level - 1], pyramid[level], sz, 0, 0, cv::INTER_LINEAR);
-    }
-    const cv::Mat& img = pyramid[level];
-    if (features_per_level_[level] <= 0) continue;
-
-    // FAST search area as in ORB-SLAM2: 16 px margins plus FAST's own 3 px radius keep every
-    // keypoint >= 19 px from the border, far enough for the rotated 31 px patch and the blur.
-    const int min_x = kEdgeThreshold - 3, min_y = kEdgeThreshold - 3;
-    const int max_x = img.cols - kEdgeThreshold + 3, max_y = img.rows - kEdgeThreshold + 3;
-    const int w = max_x - min_x, h = max_y - min_y;
-    if (w <= 2 * 3 + 1 || h <= 2 * 3 + 1) continue;
-    const cv::Mat area = img(cv::Rect(min_x, min_y, w, h));
-
-    // One FAST pass over the whole area at the initial threshold gives exactly what per-cell
-    // calls would (minus duplicates from overlapping cells); cells left empty are searched again
-    // with the fallback threshold, each on its own window so that weak corners only fill holes.
-    const int n_cols = std::max(1, w / kCellSize), n_rows = std::max(1, h / kCellSize);
-    const int cell_w = (w + n_cols - 1) / n_cols, cell_h = (h + n_rows - 1) / n_rows;
-    std::vector<cv::KeyPoint> found;
-    cv::FAST(area, found, options_.ini_th_fast, true);
-    std::vector<uint8_t> occupied(n_cols * n_rows, 0);
-    for (const cv::KeyPoint& kp : found) {
-      int cx = std::min(n_cols - 1, static_cast<int>(kp.pt.x) / cell_w);
-      int cy = std::min(n_rows - 1, static_cast<int>(kp.pt.y) / cell_h);
-      occupied[cy * n_cols + cx] = 1;
-    }
-    std::vector<cv::KeyPoint> weak;
-    for (int cy = 0; cy < n_rows; ++cy) {
-      for (int cx = 0; cx < n_cols; ++cx) {
-        if (occupied[cy * n_cols + cx]) continue;
-        const int x0 = cx * cell_w, y0 = cy * cell_h;
-        const int x1 = std::min(w, x0 + cell_w), y1 = std::min(h, y0 + cell_h);
-        if (x1 <= x0 || y1 <= y0) continue;
-        // Window grown by FAST's 3 px radius so corners on the cell's own pixels are testable.
-        const int wx0 = std::max(0, x0 - 3), wy0 = std::max(0, y0 - 3);
-        const int wx1 = std::min(w, x1 + 3), wy1 = std::min(h, y1 + 3);
-        weak.clear();
-        cv::FAST(area(cv::Rect(wx0, wy0, wx1 - wx0, wy1 - wy0)), weak, options_.min_th_fast, true);
-        for (cv::KeyPoint kp : weak) {
-          kp.pt.x += wx0;
-          kp.pt.y += wy0;
-          if (kp.pt.x >= x0 && kp.pt.x < x1 && kp.pt.y >= y0 && kp.pt.y < y1) found.push_back(kp);
-        }
-      }
-    }
-    for (cv::KeyPoint& kp : found) {
-      kp.pt.x += min_x;
-      kp.pt.y += min_y;
-    }
-
-    std::vector<cv::KeyPoint> kept =
-        distributeQuadtree(found, static_cast<float>(min_x), static_cast<float>(max_x),
-                           static_cast<float>(min_y), static_cast<float>(max_y),
-                           features_per_level_[level]);
-    const float size = static_cast<float>(kPatchSize * scale_factors_[level]);
-    for (cv::KeyPoint& kp : kept) {
-      kp.octave = level;
-      kp.size = size;
-      kp.angle = icAngle(img, kp.pt, umax_);
-      kp.class_id = -1;
-    }
-    total += static_cast<int>(kept.size());
-    level_kps[level] = std::move(kept);
+  // Level 0 needs no pyramid, and holds about as much work as all the others together (half
+  // the pixels): with two threads it runs beside the pyramid and the smaller levels. An own
+  // thread rather than cv::parallel_for_, whose pool size is process-wide and set to one by the
+  // asynchronous detector.
+  std::future<void> level0;
+  if (options_.threads > 1) {
+    level0 = std::async(std::launch::async, [&] { extractLevel(gray, 0, levels[0]); });
+  } else {
+    extractLevel(gray, 0, levels[0]);
   }
+  const std::vector<cv::Mat> pyramid = buildPyramid(gray);
+  for (int level = 1; level < n_levels; ++level) extractLevel(pyramid[level], level, levels[level]);
+  if (level0.valid()) level0.get();
 
+  size_t total = 0;
+  for (const LevelFeatures& l : levels) total += l.keypoints.size();
   keypoints.clear();
   keypoints.reserve(total);
-  descriptors.create(total, 32, CV_8U);
+  descriptors.create(static_cast<int>(total), kDescriptorBytes, CV_8U);
   int row = 0;
-  cv::Mat blurred;
-  for (int level = 0; level < n_levels; ++level) {
-    std::vector<cv::KeyPoint>& kps = level_kps[level];
-    if (kps.empty()) continue;
-    // Descriptors on a smoothed image (7x7, sigma 2) as ORB-SLAM2: BRIEF is noise sensitive.
-    cv::GaussianBlur(pyramid[level], blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
-    const float scale = static_cast<float>(scale_factors_[level]);
-    for (cv::KeyPoint& kp : kps) {
-      briefDescriptor(blurred, kp, pattern, descriptors.ptr<uint8_t>(row++));
-      if (level != 0) kp.pt *= scale;
-      keypoints.push_back(kp);
-    }
+  for (const LevelFeatures& l : levels) {
+    if (l.keypoints.empty()) continue;
+    keypoints.insert(keypoints.end(), l.keypoints.begin(), l.keypoints.end());
+    l.descriptors.copyTo(descriptors.rowRange(row, row + l.descriptors.rows));
+    row += l.descriptors.rows;
   }
 }
 

@@ -154,6 +154,34 @@ TEST(OrbExtractor, IsDeterministic) {
   EXPECT_EQ(cv::norm(da, db, cv::NORM_L1), 0.0);
 }
 
+// The second thread only moves level 0 off the caller's thread: same keypoints, same order,
+// same descriptors.
+TEST(OrbExtractor, TwoThreadsGiveTheSameFeaturesAsOne) {
+  cv::Mat gray = loadTumGray();
+  OrbOptions one_opt, two_opt;
+  one_opt.threads = 1;
+  two_opt.threads = 2;
+  OrbExtractor one(one_opt), two(two_opt);
+  std::vector<cv::KeyPoint> k1, k2;
+  cv::Mat d1, d2;
+  one.extract(gray, k1, d1);
+  for (int run = 0; run < 3; ++run) {
+    two.extract(gray, k2, d2);
+    ASSERT_EQ(k1.size(), k2.size());
+    for (size_t i = 0; i < k1.size(); ++i) {
+      EXPECT_EQ(k1[i].pt, k2[i].pt);
+      EXPECT_EQ(k1[i].angle, k2[i].angle);
+      EXPECT_EQ(k1[i].octave, k2[i].octave);
+      EXPECT_EQ(k1[i].response, k2[i].response);
+    }
+    EXPECT_EQ(cv::norm(d1, d2, cv::NORM_L1), 0.0);
+  }
+  EXPECT_GT(k1.size(), 900u);
+  EXPECT_EQ(OrbOptions::load(Config::fromString("ORBextractor.threads: 1\n")).threads, 1);
+  EXPECT_THROW(OrbOptions::load(Config::fromString("ORBextractor.threads: 3\n")), Error);
+  EXPECT_THROW(OrbOptions::load(Config::fromString("ORBextractor.threads: 0\n")), Error);
+}
+
 TEST(OrbExtractor, BadAndDegenerateInputs) {
   OrbExtractor orb(OrbOptions{});
   std::vector<cv::KeyPoint> kps;

@@ -27,6 +27,11 @@ struct OrbOptions {
   // stay for SLAM (1: ORB-SLAM2's fixed budget). Crowds otherwise leave too few
   // static points to initialise and track.
   double dynamic_boost_max = 2.0;
+  // ORBextractor.threads: 2 extracts pyramid level 0 on a second thread beside the other
+  // levels (the same keypoints and descriptors as 1, in about 60 % of the time when a core is
+  // free); 1 extracts on the caller's thread only.
+  static constexpr int kMaxThreads = 2;
+  int threads = 2;
 
   // Reads the ORBextractor.* keys above (missing keys keep the defaults). Throws
   // yolo_slam::Error naming the file and key for out-of-range values.
@@ -41,6 +46,8 @@ class OrbExtractor {
   static constexpr int kHalfPatchSize = 15;
   static constexpr int kEdgeThreshold = 19;   // keypoints stay this far from each level's border
   static constexpr int kCellSize = 30;        // FAST cell size in pixels (per level)
+  static constexpr int kFastRadius = 3;       // FAST's Bresenham circle
+  static constexpr int kDescriptorBytes = 32;  // 256 BRIEF tests
 
   explicit OrbExtractor(const OrbOptions& options);
 
@@ -63,6 +70,16 @@ class OrbExtractor {
   static const std::vector<cv::Point>& briefPattern();
 
  private:
+  struct LevelFeatures {
+    std::vector<cv::KeyPoint> keypoints;  // level-0 pixel coordinates, octave = level
+    cv::Mat descriptors;                  // one row per keypoint
+  };
+  // Level l is the level l-1 resized by 1/scaleFactor; levels too small for a patch stay empty.
+  std::vector<cv::Mat> buildPyramid(const cv::Mat& gray) const;
+  std::vector<cv::KeyPoint> fastCorners(const cv::Mat& area) const;
+  // Keypoints and descriptors of one pyramid level (img empty: none).
+  void extractLevel(const cv::Mat& img, int level, LevelFeatures& out) const;
+
   OrbOptions options_;
   std::vector<double> scale_factors_, inv_scale_factors_, level_sigma2_, inv_level_sigma2_;
   std::vector<int> features_per_level_;
