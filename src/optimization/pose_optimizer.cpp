@@ -6,6 +6,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -14,23 +15,75 @@ namespace optimization {
 
 namespace {
 
-// Huber that can be switched to plain least squares between rounds without rebuilding the
-// problem (ORB-SLAM2 removes the kernel for the last round).
-class SwitchableHuber final : public ceres::LossFunction {
+// Every observation of the frame in one residual block of Ceres: the problem has a single 6-dof
+// parameter, and per-block bookkeeping (one virtual call, validity checks and a manifold
+// Jacobian per observation and iteration) cost several times the residuals themselves
+// (bench/optimization_bench). The Huber kernel is applied per observation inside, as g2o (and
+// so ORB-SLAM2) does: the cost is rho(s) of each squared error s, the Jacobian the observation's
+// own scaled by sqrt(rho'(s)) (iteratively reweighted least squares). An inactive observation
+// contributes 0 with a zero Jacobian (ORB-SLAM2's "level 1" edges).
+class StackedPoseCost final : public ceres::CostFunction {
  public:
-  SwitchableHuber(double delta, const bool* robust) : huber_(delta), robust_(robust) {}
-  void Evaluate(double s, double rho[3]) const override {
-    if (*robust_) {
-      huber_.Evaluate(s, rho);
-    } else {
-      rho[0] = s;
-      rho[1] = 1.0;
-      rho[2] = 0.0;
+  StackedPoseCost(const Intrinsics& K, const std::vector<PoseObservation>& obs, const bool* active,
+                  const bool* robust)
+      : K_(K), obs_(obs), active_(active), robust_(robust) {
+    int rows = 0;
+    for (const PoseObservation& o : obs) rows += rowsOf(o);
+    set_num_residuals(rows);
+    mutable_parameter_block_sizes()->push_back(kPoseParams);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    double* jac = jacobians ? jacobians[0] : nullptr;
+    int row = 0;
+    for (size_t i = 0; i < obs_.size(); ++i) {
+      const int n = rowsOf(obs_[i]);
+      double* r = residuals + row;
+      double* J = jac ? jac + row * kPoseParams : nullptr;
+      if (!evaluateOne(parameters[0], i, n, r, J)) return false;
+      row += n;
     }
+    return true;
   }
 
  private:
-  ceres::HuberLoss huber_;
+  static int rowsOf(const PoseObservation& o) { return o.u_right >= 0 ? 3 : 2; }
+
+  bool evaluateOne(const double* pose, size_t i, int n, double* r, double* J) const {
+    if (!active_[i]) {
+      std::fill(r, r + n, 0.0);
+      if (J) std::fill(J, J + n * kPoseParams, 0.0);
+      return true;
+    }
+    const PoseObservation& o = obs_[i];
+    const double sqrt_info = std::sqrt(o.inv_sigma2);
+    bool ok;
+    if (n == 3) {
+      const double m[3] = {o.uv.x(), o.uv.y(), o.u_right};
+      ok = reprojectionResidual<3>(K_, pose, o.Xw, m, sqrt_info, r, J, nullptr);
+    } else {
+      ok = reprojectionResidual<2>(K_, pose, o.Xw, o.uv.data(), sqrt_info, r, J, nullptr);
+    }
+    if (ok && *robust_) robustify(n, n == 3 ? kChi2Stereo : kChi2Mono, r, J);
+    return ok;
+  }
+
+  // Huber with threshold delta^2 = chi2: beyond it rho(s) = 2 delta sqrt(s) - delta^2.
+  static void robustify(int n, double chi2, double* r, double* J) {
+    double s = 0;
+    for (int k = 0; k < n; ++k) s += r[k] * r[k];
+    if (!(s > chi2)) return;
+    const double delta = std::sqrt(chi2), root = std::sqrt(s);
+    const double r_scale = std::sqrt((2 * delta * root - chi2) / s);
+    for (int k = 0; k < n; ++k) r[k] *= r_scale;
+    if (!J) return;
+    const double j_scale = std::sqrt(delta / root);
+    for (int k = 0; k < n * kPoseParams; ++k) J[k] *= j_scale;
+  }
+
+  Intrinsics K_;
+  const std::vector<PoseObservation>& obs_;
+  const bool* active_;
   const bool* robust_;
 };
 
@@ -87,30 +140,20 @@ int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObser
   double pose[kPoseParams];
   poseToParams(T_cw, pose);
 
-  // Cost and loss functions live here; the problem only borrows them.
   std::unique_ptr<bool[]> active(new bool[n]);
+  for (size_t i = 0; i < n; ++i) active[i] = !is_outlier[i];
   bool robust = true;
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  costs.reserve(n_usable);
-  SwitchableHuber loss_mono(std::sqrt(kChi2Mono), &robust);
-  SwitchableHuber loss_stereo(std::sqrt(kChi2Stereo), &robust);
+  StackedPoseCost cost(K, obs, active.get(), &robust);
   SE3LeftManifold manifold;
 
   ceres::Problem::Options popts;
   popts.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(popts);
   problem.AddParameterBlock(pose, kPoseParams, &manifold);
-  for (size_t i = 0; i < n; ++i) {
-    active[i] = !is_outlier[i];
-    if (is_outlier[i]) continue;
-    const PoseObservation& o = obs[i];
-    costs.emplace_back(newPoseOnlyCost(K, o.Xw, o.uv, o.u_right, o.inv_sigma2, &active[i]));
-    problem.AddResidualBlock(costs.back().get(), o.u_right >= 0 ? &loss_stereo : &loss_mono, pose);
-  }
+  problem.AddResidualBlock(&cost, nullptr, pose);
 
-  const ceres::Solver::Options sopts = solverOptions(ceres::DENSE_QR, kIterationsPerRound);
+  const ceres::Solver::Options sopts = solverOptions(ceres::DENSE_NORMAL_CHOLESKY, kIterationsPerRound);
   int n_bad = 0;
   for (int round = 0; round < rounds; ++round) {
     ceres::Solver::Summary summary;
