@@ -45,6 +45,7 @@ ORBextractor.nLevels: 6
 ORBextractor.iniThFAST: 18
 ORBextractor.minThFAST: 6
 ORBextractor.dynamicBoostMax: 1.5
+ORBextractor.threads: 1
 Detector.model: "/tmp/ys_model"
 Detector.extraModels: [ "/tmp/ys_extra_a", "/tmp/ys_extra_b" ]
 Detector.inputWidth: 320
@@ -205,6 +206,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(orb.n_features, orb.scale_factor, orb.n_levels, orb.ini_th_fast, orb.min_th_fast),
             std::make_tuple(1500, 1.25, 6, 18, 6));
   EXPECT_DOUBLE_EQ(orb.dynamic_boost_max, 1.5);
+  EXPECT_EQ(orb.threads, 1);
   EXPECT_TRUE(sys.sequential);
   const mapping::DenseMapOptions& dm = sys.dense;
   EXPECT_EQ(std::tie(dm.enabled, dm.resolution_m, dm.max_range_m, dm.pixel_stride, dm.cloud_resolution_m),
