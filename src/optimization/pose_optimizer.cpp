@@ -18,10 +18,9 @@ namespace {
 // Every observation of the frame in one residual block of Ceres: the problem has a single 6-dof
 // parameter, and per-block bookkeeping (one virtual call, validity checks and a manifold
 // Jacobian per observation and iteration) cost several times the residuals themselves
-// (bench/optimization_bench). The Huber kernel is applied per observation inside, as g2o (and
-// so ORB-SLAM2) does: the cost is rho(s) of each squared error s, the Jacobian the observation's
-// own scaled by sqrt(rho'(s)) (iteratively reweighted least squares). An inactive observation
-// contributes 0 with a zero Jacobian (ORB-SLAM2's "level 1" edges).
+// (bench/optimization_bench). The Huber kernel is applied per observation inside: the cost is
+// the sum of rho(s) over the squared errors s, as with a HuberLoss per observation. An inactive
+// observation contributes 0 with a zero Jacobian (ORB-SLAM2's "level 1" edges).
 class StackedPoseCost final : public ceres::CostFunction {
  public:
   StackedPoseCost(const Intrinsics& K, const std::vector<PoseObservation>& obs, const bool* active,
@@ -64,21 +63,8 @@ class StackedPoseCost final : public ceres::CostFunction {
     } else {
       ok = reprojectionResidual<2>(K_, pose, o.Xw, o.uv.data(), sqrt_info, r, J, nullptr);
     }
-    if (ok && *robust_) robustify(n, n == 3 ? kChi2Stereo : kChi2Mono, r, J);
+    if (ok && *robust_) applyHuber(n, n == 3 ? kChi2Stereo : kChi2Mono, r, J);
     return ok;
-  }
-
-  // Huber with threshold delta^2 = chi2: beyond it rho(s) = 2 delta sqrt(s) - delta^2.
-  static void robustify(int n, double chi2, double* r, double* J) {
-    double s = 0;
-    for (int k = 0; k < n; ++k) s += r[k] * r[k];
-    if (!(s > chi2)) return;
-    const double delta = std::sqrt(chi2), root = std::sqrt(s);
-    const double r_scale = std::sqrt((2 * delta * root - chi2) / s);
-    for (int k = 0; k < n; ++k) r[k] *= r_scale;
-    if (!J) return;
-    const double j_scale = std::sqrt(delta / root);
-    for (int k = 0; k < n * kPoseParams; ++k) J[k] *= j_scale;
   }
 
   Intrinsics K_;

@@ -59,6 +59,48 @@ TEST(Reprojection, AnalyticJacobiansMatchNumeric) {
   }
 }
 
+// The Huber-scaled residual of an outlier: |r|^2 is rho(s), and its Jacobian matches finite
+// differences (an inexact one would move the optimum towards the outliers).
+TEST(Reprojection, HuberScaledResidualAndJacobian) {
+  CameraModel cam;
+  Intrinsics K = Intrinsics::from(cam);
+  std::mt19937 gen(3);
+  Pose T = randomPose(gen, 0.3, 0.5);
+  double pose[7];
+  poseToParams(T, pose);
+  const Eigen::Vector3d Xw = T.inverse() * Eigen::Vector3d(0.3, -0.2, 2.5);
+  const Eigen::Vector3d far_off(390, 150, 360);  // tens of pixels from the projection
+  SE3LeftManifold m;
+  auto scaled = [&](const double* p, double* r, double* J) {
+    reprojectionResidual<3>(K, p, Xw, far_off.data(), 0.7, r, J, nullptr);
+    applyHuber(3, kChi2Stereo, r, J);
+  };
+  double raw[3];
+  reprojectionResidual<3>(K, pose, Xw, far_off.data(), 0.7, raw, nullptr, nullptr);
+  const double s = raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2];
+  ASSERT_GT(s, 10 * kChi2Stereo);
+  double r0[3], J[3 * 7];
+  scaled(pose, r0, J);
+  const double rho = 2 * std::sqrt(kChi2Stereo * s) - kChi2Stereo;
+  EXPECT_NEAR(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2], rho, 1e-9 * rho);
+  const double h = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    double delta[6] = {0, 0, 0, 0, 0, 0}, moved[7], r1[3];
+    delta[k] = h;
+    m.Plus(pose, delta, moved);
+    scaled(moved, r1, nullptr);
+    for (int r = 0; r < 3; ++r) EXPECT_NEAR((r1[r] - r0[r]) / h, J[r * 7 + k], 1e-3 * (1 + std::abs(J[r * 7 + k])));
+  }
+  // An inlier is left as it is.
+  const Eigen::Vector2d uv = cam.project(T * Xw);
+  const Eigen::Vector3d near(uv.x() + 0.5, uv.y(), uv.x() - cam.bf / (T * Xw).z());
+  double ri[3], Ji[3 * 7], ri0[3];
+  reprojectionResidual<3>(K, pose, Xw, near.data(), 0.7, ri0, nullptr, nullptr);
+  reprojectionResidual<3>(K, pose, Xw, near.data(), 0.7, ri, Ji, nullptr);
+  applyHuber(3, kChi2Stereo, ri, Ji);
+  for (int r = 0; r < 3; ++r) EXPECT_EQ(ri[r], ri0[r]);
+}
+
 TEST(SE3Manifold, PlusMinusRoundTrip) {
   SE3LeftManifold m;
   std::mt19937 gen(2);

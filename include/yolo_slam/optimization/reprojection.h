@@ -42,6 +42,30 @@ ReprojectionCheck checkReprojection(const Intrinsics& K, const double* pose,
                                     const Eigen::Vector3d& Xw, const Eigen::Vector2d& uv,
                                     double u_right, double inv_sigma2);
 
+// Huber kernel on one observation's whitened residual r (rows x 1) and its pose Jacobian J
+// (rows x 7 row-major, may be null), threshold delta^2 = chi2: beyond it the cost is
+// rho(s) = 2 delta sqrt(s) - delta^2 of s = |r|^2. r becomes g r with g^2 = rho(s) / s, so
+// |r|^2 = rho(s), and J its exact Jacobian g (I - c r r^T) J, c = (delta sqrt(s) - delta^2) /
+// (s rho(s)); the gradient is then rho'(s) J^T r, as with a ceres::HuberLoss on the block.
+inline void applyHuber(int rows, double chi2, double* r, double* J) {
+  constexpr int kCols = 7;
+  double s = 0;
+  for (int k = 0; k < rows; ++k) s += r[k] * r[k];
+  if (!(s > chi2)) return;
+  const double delta = std::sqrt(chi2), root = std::sqrt(s);
+  const double rho = 2 * delta * root - chi2;
+  const double g = std::sqrt(rho / s);
+  if (J) {
+    const double c = (delta * root - chi2) / (s * rho);
+    double rJ[kCols] = {0};
+    for (int i = 0; i < rows; ++i)
+      for (int k = 0; k < kCols; ++k) rJ[k] += r[i] * J[i * kCols + k];
+    for (int i = 0; i < rows; ++i)
+      for (int k = 0; k < kCols; ++k) J[i * kCols + k] = g * (J[i * kCols + k] - c * r[i] * rJ[k]);
+  }
+  for (int k = 0; k < rows; ++k) r[k] *= g;
+}
+
 // Pose-only: the 3D point is a constant. `active` (may be null) lets the pose optimizer switch
 // an observation off without rebuilding the problem: an inactive residual is 0 with zero
 // Jacobian (ORB-SLAM2's "level 1" edges).
