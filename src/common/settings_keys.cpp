@@ -177,6 +177,8 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.motionWindow",
       "Tracking.refRatio",
       "Tracking.voPoints",
+      "Tracking.youngLostResetFrames",
+      "Tracking.youngMapFrames",
   };
   return keys;
 }

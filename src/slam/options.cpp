@@ -24,6 +24,8 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.closeUntrackedMin", &O::close_untracked_min, Range::atLeast(0)},
       {"Tracking.lostResetFrames", &O::lost_reset_frames, Range::atLeast(1)},
       {"Tracking.lostResetMaxKeyFrames", &O::lost_reset_max_keyframes, Range::atLeast(0)},
+      {"Tracking.youngMapFrames", &O::young_map_frames, Range::atLeast(1)},
+      {"Tracking.youngLostResetFrames", &O::young_lost_reset_frames, Range::atLeast(0)},
       {"Tracking.voPoints", &O::vo_points, Range::atLeast(0)},
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
   };

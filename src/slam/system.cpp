@@ -246,7 +246,7 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
     else ++stats_.lost;
   }
   if (reset_requested) {
-    log::warn("frame %.6f: lost for long with a small map; map reset", frame.stamp);
+    log::warn("frame %.6f: lost with a small or young map; map reset", frame.stamp);
     resetInternal(true);
   } else if (run_mode_ == RunMode::Sequential) {
     runBackEndInline();

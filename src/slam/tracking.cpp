@@ -219,14 +219,24 @@ void Tracking::onFailed(TrackResult& res) {
     state_ = TrackingState::Lost;
     has_velocity_ = false;
   }
-  if (state_ == TrackingState::Lost && lost_frames_in_row_ >= opt_.lost_reset_frames &&
-      static_cast<int>(map_.numKeyFrames()) <= opt_.lost_reset_max_keyframes && !localization_only_) {
+  if (state_ == TrackingState::Lost && !localization_only_ && (lostLongInSmallMap() || lostYoung()))
     reset_requested_ = true;
-  }
+}
+
+bool Tracking::lostLongInSmallMap() const {
+  return lost_frames_in_row_ >= opt_.lost_reset_frames &&
+         static_cast<int>(map_.numKeyFrames()) <= opt_.lost_reset_max_keyframes;
+}
+
+bool Tracking::lostYoung() const {
+  if (opt_.young_lost_reset_frames <= 0 || init_frame_id_ < 0 || last_tracked_id_ < 0) return false;
+  return last_tracked_id_ - init_frame_id_ < opt_.young_map_frames &&
+         lost_frames_in_row_ >= opt_.young_lost_reset_frames;
 }
 
 void Tracking::acceptFrame(const Frame& F, TrackResult& res) {
   ++tracked_;
+  last_tracked_id_ = F.id;
   res.state = TrackingState::Ok;
   res.T_wc = F.Twc();
   record(F);
@@ -252,6 +262,7 @@ bool Tracking::initialize(Frame& F) {
   last_kf_ = kf;
   ref_kf_ = kf;
   last_kf_frame_id_ = F.id;
+  init_frame_id_ = F.id;
   local_kfs_ = {kf};
   local_points_ = kf->mapPoints();
   has_velocity_ = false;
@@ -697,6 +708,8 @@ void Tracking::resetKeepTrajectory() {
   last_kf_.reset();
   last_ref_.reset();
   last_kf_frame_id_ = -1;
+  init_frame_id_ = -1;
+  last_tracked_id_ = -1;
   has_velocity_ = false;
   failures_in_row_ = 0;
   lost_frames_in_row_ = 0;

@@ -24,6 +24,12 @@ struct TrackingOptions {
   int close_untracked_min = 70;     // Tracking.closeUntrackedMin:  and untracked > this)
   int lost_reset_frames = 150;      // Tracking.lostResetFrames: lost for this many frames ...
   int lost_reset_max_keyframes = 5; // Tracking.lostResetMaxKeyFrames: ... with a map this small: reset
+  // A young map (lost within young_map_frames frames of its initialisation) is reset after
+  // young_lost_reset_frames lost frames, whatever its size: a map made while people covered
+  // much of the view holds few static points and rarely relocalises (crowd preset, issue 23);
+  // a new one starts at the last good pose. 0 turns it off.
+  int young_map_frames = 30;        // Tracking.youngMapFrames
+  int young_lost_reset_frames = 5;  // Tracking.youngLostResetFrames
   int vo_points = 100;              // Tracking.voPoints: temporary close points in the last frame
   double max_stamp_gap = 1.0;       // Tracking.maxStampGap (s): a larger gap drops the motion model
 

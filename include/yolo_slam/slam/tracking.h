@@ -75,6 +75,11 @@ class Tracking {
   bool trackFrame(Frame& F);
   void onTracked(Frame& F, TrackResult& res);
   void onFailed(TrackResult& res);
+  // Reset rules of a lost map: lost for lost_reset_frames with at most lost_reset_max_keyframes
+  // keyframes; lost within young_map_frames of the map's initialisation for
+  // young_lost_reset_frames.
+  bool lostLongInSmallMap() const;
+  bool lostYoung() const;
   // F becomes the last (good) frame and is recorded in the trajectory.
   void acceptFrame(const Frame& F, TrackResult& res);
   bool initialize(Frame& F);
@@ -136,6 +141,8 @@ class Tracking {
   Pose last_good_T_wc_ = Pose::Identity();
   bool has_last_good_ = false;
   bool reset_requested_ = false;
+  long init_frame_id_ = -1;     // the frame this map was initialised at (-1: loaded or none)
+  long last_tracked_id_ = -1;   // the last frame tracked in this map
   std::vector<KeyFramePtr> local_kfs_;
   std::vector<MapPointPtr> local_points_;
   std::vector<MapPointPtr> dynamic_hits_;
