@@ -21,17 +21,29 @@ Pose randomPose(std::mt19937& gen, double rot, double trans) {
   return T;
 }
 
+// A camera, a random pose (also as Ceres parameters) and a world point 2.5 m in front of it.
+struct PoseFixture {
+  CameraModel cam;
+  Intrinsics K = Intrinsics::from(cam);
+  Pose T;
+  double pose[7];
+  Eigen::Vector3d Xw;
+  explicit PoseFixture(unsigned seed) {
+    std::mt19937 gen(seed);
+    T = randomPose(gen, 0.3, 0.5);
+    poseToParams(T, pose);
+    Xw = T.inverse() * Eigen::Vector3d(0.3, -0.2, 2.5);
+  }
+};
+
 }  // namespace
 
 // The analytic Jacobians must match finite differences through SE3LeftManifold::Plus.
 TEST(Reprojection, AnalyticJacobiansMatchNumeric) {
-  CameraModel cam;
-  Intrinsics K = Intrinsics::from(cam);
-  std::mt19937 gen(1);
-  Pose T = randomPose(gen, 0.3, 0.5);
-  double pose[7];
-  poseToParams(T, pose);
-  Eigen::Vector3d Xw = T.inverse() * Eigen::Vector3d(0.3, -0.2, 2.5);
+  const PoseFixture f(1);
+  const Intrinsics& K = f.K;
+  const double* pose = f.pose;
+  const Eigen::Vector3d& Xw = f.Xw;
   Eigen::Vector3d obs(300, 200, 280);
   SE3LeftManifold m;
   for (int rows : {2, 3}) {
@@ -62,13 +74,12 @@ TEST(Reprojection, AnalyticJacobiansMatchNumeric) {
 // The Huber-scaled residual of an outlier: |r|^2 is rho(s), and its Jacobian matches finite
 // differences (an inexact one would move the optimum towards the outliers).
 TEST(Reprojection, HuberScaledResidualAndJacobian) {
-  CameraModel cam;
-  Intrinsics K = Intrinsics::from(cam);
-  std::mt19937 gen(3);
-  Pose T = randomPose(gen, 0.3, 0.5);
-  double pose[7];
-  poseToParams(T, pose);
-  const Eigen::Vector3d Xw = T.inverse() * Eigen::Vector3d(0.3, -0.2, 2.5);
+  const PoseFixture f(3);
+  const CameraModel& cam = f.cam;
+  const Intrinsics& K = f.K;
+  const Pose& T = f.T;
+  const double* pose = f.pose;
+  const Eigen::Vector3d& Xw = f.Xw;
   const Eigen::Vector3d far_off(390, 150, 360);  // tens of pixels from the projection
   SE3LeftManifold m;
   auto scaled = [&](const double* p, double* r, double* J) {
