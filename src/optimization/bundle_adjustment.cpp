@@ -130,8 +130,10 @@ std::shared_ptr<ceres::ParameterBlockOrdering> schurOrdering(Workspace& w, const
   return ordering;
 }
 
-// Above this many free poses the sparse Schur solver beats the dense one (this project's choice).
-constexpr int kMaxDensePoses = 60;
+// Above this many free poses the sparse Schur solver beats the dense one: measured with
+// optimization_bench (wide windows) and on crowded sequences, whose local windows reach 80 free
+// keyframes with every point seen by many of them (BENCHMARKS.md, "Local BA").
+constexpr int kMaxDensePoses = 100;
 
 // One Ceres solve over the observations with include[i] set. Returns the iterations used.
 int solveStage(const Intrinsics& K, Workspace& w, const BaProblem& p,

@@ -19,18 +19,21 @@ struct Synthetic {
   std::vector<bool> bad_obs;                 // injected gross outliers
 };
 
-// 8 keyframes moving sideways in front of a point cloud; keyframes 0 and 1 fixed. Free poses
-// and all points perturbed (3 cm / 0.6 deg poses, 20 cm points); 1 px noise; 3% gross outliers.
-Synthetic makeSynthetic(unsigned seed) {
+// n_kf keyframes moving 84 cm sideways in front of a point cloud; keyframes 0 and 1 fixed. Free
+// poses and all points perturbed (3 cm / 0.6 deg poses, 20 cm points); 1 px noise; 3% gross
+// outliers.
+Synthetic makeSynthetic(unsigned seed, int n_kf = 8) {
   Synthetic s;
   CameraModel cam;
   std::mt19937 gen(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   std::uniform_real_distribution<double> ux(-2.0, 2.0), uy(-1.5, 1.5), uz(2.0, 6.0), coin(0, 1);
-  for (int k = 0; k < 8; ++k) {
+  const double step = 7.0 / (n_kf - 1);  // in units of the 8-keyframe path's steps
+  for (int k = 0; k < n_kf; ++k) {
+    const double a = step * k;
     Pose T_wc = Pose::Identity();
-    T_wc.linear() = expSO3(Eigen::Vector3d(0.01 * k, 0.03 * k, 0));
-    T_wc.translation() = Eigen::Vector3d(0.12 * k, 0.02 * k, 0.03 * k);
+    T_wc.linear() = expSO3(Eigen::Vector3d(0.01 * a, 0.03 * a, 0));
+    T_wc.translation() = Eigen::Vector3d(0.12 * a, 0.02 * a, 0.03 * a);
     s.true_poses.push_back(T_wc.inverse());
     Pose T = s.true_poses.back();
     const bool fixed = k < 2;
@@ -44,7 +47,7 @@ Synthetic makeSynthetic(unsigned seed) {
     Eigen::Vector3d X(ux(gen), uy(gen), uz(gen));
     s.true_points.push_back(X);
     s.problem.points.push_back({5000 + j, X + 0.2 * Eigen::Vector3d(n(gen), n(gen), n(gen))});
-    for (int k = 0; k < 8; ++k) {
+    for (int k = 0; k < n_kf; ++k) {
       Eigen::Vector3d pc = s.true_poses[k] * X;
       Eigen::Vector2d uv = cam.project(pc);
       if (pc.z() < 0.1 || !cam.inImage(uv.x(), uv.y()) || coin(gen) < 0.3) continue;
@@ -116,6 +119,17 @@ TEST(BundleAdjustment, LocalBaReducesErrorAndKeepsFixedKeyframes) {
   ASSERT_GT(bad, 10);
   EXPECT_EQ(caught, bad);
   EXPECT_LT(false_alarm, 0.08 * good);
+}
+
+// More free keyframes than the dense reduced camera system is used for: the sparse solver.
+TEST(BundleAdjustment, WideWindowConverges) {
+  CameraModel cam;
+  Synthetic s = makeSynthetic(9, 110);
+  const double pose_err0 = poseError(s);
+  BaResult r = localBundleAdjustment(cam, s.problem);
+  EXPECT_LT(r.final_cost, 0.2 * r.initial_cost);
+  EXPECT_LT(poseError(s), 0.2 * pose_err0);
+  EXPECT_LT(poseError(s), 0.008);
 }
 
 TEST(BundleAdjustment, GlobalBaReducesCost) {
