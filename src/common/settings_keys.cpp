@@ -118,6 +118,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Screening.motionSupportRadius",
       "Screening.noDepth",
       "Screening.noDepthHoleRadius",
+      "Screening.noDepthProbeRadius",
       "Screening.noDepthRadius",
       "Screening.occlusionMaxIou",
       "Screening.occlusionRule",

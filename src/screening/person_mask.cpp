@@ -84,14 +84,17 @@ float distanceAt(const cv::Mat& distance, const cv::Point2f& p) {
   return distance.at<float>(c.y, c.x);
 }
 
+bool personCellAt(const cv::Mat& mask, const cv::Point2f& p) {
+  const cv::Point c = cellOf(p);
+  return cv::Rect(cv::Point(0, 0), mask.size()).contains(c) && mask.at<uint8_t>(c.y, c.x) == kPerson;
+}
+
 int markGrownOutside(const features::FeatureFrame& frame, const cv::Mat& mask,
                      const std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop) {
   int marked = 0;
-  const cv::Rect cells(cv::Point(0, 0), mask.size());
   for (size_t i = 0; i < frame.keypoints.size(); ++i) {
     if (in_any[i] || drop[i] || frame.depth[i] <= 0) continue;
-    const cv::Point c = cellOf(frame.keypoints[i].pt);
-    if (!cells.contains(c) || mask.at<uint8_t>(c.y, c.x) != kPerson) continue;
+    if (!personCellAt(mask, frame.keypoints[i].pt)) continue;
     drop[i] = 1;
     ++marked;
   }

@@ -63,6 +63,7 @@ const OptionTable<ScreeningOptions>& screeningFields() {
       {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
       {"Screening.growOutside", &O::grow_outside, Range::closed(0, 1)},
       {"Screening.noDepthHoleRadius", &O::no_depth_hole_radius_px, Range::atLeast(0)},
+      {"Screening.noDepthProbeRadius", &O::no_depth_probe_radius_px, Range::atLeast(0)},
   };
   return table;
 }
@@ -246,6 +247,12 @@ struct Region {
   std::vector<uint8_t> member;
 };
 
+// What the rules after the person sets read of the image (each may be empty): the depth image
+// (metres), the grown person mask and the distance to it (person_mask.h).
+struct PersonPixels {
+  cv::Mat depth, mask, distance;
+};
+
 // The depth image for the silhouette rule and screening beyond the boxes (may be empty);
 // throws unless it is CV_32FC1 of the frame's size.
 void checkDepthImage(const features::FeatureFrame& frame, const cv::Mat& depth_m) {
@@ -351,6 +358,33 @@ int markSilhouette(const ScreeningOptions& o, const features::FeatureFrame& fram
   return dropped;
 }
 
+// What the nearest valid depth pixels around a keypoint without depth show.
+enum class Probe { Person, Other, Nothing };
+
+// The first square ring around the keypoint (radius 0 to radius_px times its scale) holding a
+// valid depth pixel: Person when one of them lies on the grown person mask, else Other;
+// Nothing when no ring does.
+Probe probeDepth(const cv::Mat& depth_m, const cv::Mat& person_mask, const cv::KeyPoint& kp,
+                 double radius_px) {
+  const int rmax = std::max(1, static_cast<int>(std::lround(radius_px * kp.size / 31.f)));
+  const int cx = static_cast<int>(std::lround(kp.pt.x)), cy = static_cast<int>(std::lround(kp.pt.y));
+  for (int k = 0; k <= rmax; ++k) {
+    bool any = false, person = false;
+    for (int v = std::max(0, cy - k); v <= std::min(depth_m.rows - 1, cy + k); ++v) {
+      const float* row = depth_m.ptr<float>(v);
+      const bool edge_row = v == cy - k || v == cy + k;
+      const int step = edge_row || k == 0 ? 1 : 2 * k;  // inner rows: the two side pixels only
+      for (int u = cx - k; u <= cx + k; u += step) {
+        if (u < 0 || u >= depth_m.cols || row[u] <= 0.f) continue;
+        any = true;
+        person = person || personCellAt(person_mask, cv::Point2f(u, v));
+      }
+    }
+    if (any) return person ? Probe::Person : Probe::Other;
+  }
+  return Probe::Nothing;
+}
+
 // NearDynamic: whether a person keypoint with depth lies within no_depth_radius_px of p.
 bool memberNear(const ScreeningOptions& o, const Region& r, const cv::Point2f& p) {
   const float nd2 = static_cast<float>(o.no_depth_radius_px * o.no_depth_radius_px);
@@ -376,12 +410,15 @@ uint8_t nearestLabel(const ScreeningOptions& o, const Region& r, const cv::Point
   return label;
 }
 
-// The no-depth rule over the region's keypoints without depth; person_distance (empty when
-// screening beyond the boxes is off) narrows near-dynamic to holes near a person's pixels.
+// The no-depth rule over the region's keypoints without depth; person.distance (empty when
+// screening beyond the boxes is off) narrows near-dynamic to holes near a person's pixels, and
+// the depth probe (no_depth_probe_radius_px, needs person.depth and person.mask) to holes
+// whose nearest valid depth is the person's.
 void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
-                 const cv::Mat& person_distance, std::vector<uint8_t>& drop) {
+                 const PersonPixels& person, std::vector<uint8_t>& drop) {
   using Rule = ScreeningOptions::NoDepthRule;
   if (o.no_depth == Rule::Static) return;
+  const bool probe = r.box && o.no_depth_probe_radius_px > 0 && !person.depth.empty() && !person.mask.empty();
   for (int i : r.idx) {
     if (frame.depth[i] > 0) continue;
     const cv::Point2f p = frame.keypoints[i].pt;
@@ -389,9 +426,12 @@ void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
     bool dynamic = true;  // Rule::Dynamic
     if (o.no_depth == Rule::NearDynamic) {
       dynamic = memberNear(o, r, p) &&
-                (person_distance.empty() || distanceAt(person_distance, p) <= o.no_depth_hole_radius_px);
+                (person.distance.empty() || distanceAt(person.distance, p) <= o.no_depth_hole_radius_px);
     }
     if (o.no_depth == Rule::Nearest) dynamic = nearestLabel(o, r, p) != 0;
+    // The hole's own surroundings overrule the neighbours: background all around, background.
+    if (dynamic && probe)
+      dynamic = probeDepth(person.depth, person.mask, frame.keypoints[i], o.no_depth_probe_radius_px) != Probe::Other;
     if (dynamic) drop[i] = 1;
   }
 }
@@ -399,13 +439,12 @@ void markNoDepth(const ScreeningOptions& o, const features::FeatureFrame& frame,
 // Marks one region whose person set findPerson found: the set is dropped, then the silhouette
 // and no-depth rules. (A flat box is not marked at all.)
 void markRegion(const ScreeningOptions& o, const features::FeatureFrame& frame, const Region& r,
-                const cv::Mat& silhouette_depth, const cv::Mat& person_distance,
-                std::vector<uint8_t>& drop, ScreeningStats& st) {
+                const PersonPixels& person, std::vector<uint8_t>& drop, ScreeningStats& st) {
   for (size_t m = 0; m < r.member.size(); ++m)
     if (r.member[m]) drop[r.with_depth[m]] = 1;
-  if (r.box && !silhouette_depth.empty())
-    st.silhouette += markSilhouette(o, frame, r, silhouette_depth, drop);
-  markNoDepth(o, frame, r, person_distance, drop);
+  if (r.box && !person.depth.empty() && o.silhouette_radius_px > 0)
+    st.silhouette += markSilhouette(o, frame, r, person.depth, drop);
+  markNoDepth(o, frame, r, person, drop);
 }
 
 // The grow seeds of a region's person set: its keypoints with depth, their depth range widened
@@ -504,14 +543,14 @@ void markBoxes(const Screener& s, const features::FeatureFrame& frame, const det
     flat[b] = o.reject_flat_boxes && isFlatBox(o, frame, regions[b], boxes);
     st.flat_boxes += flat[b];
   }
-  cv::Mat mask;
-  const cv::Mat distance = personDistanceOf(o, regions, flat, boxes, depth_m, mask);
-  const cv::Mat silhouette_depth = o.silhouette_radius_px > 0 ? depth_m : cv::Mat();
+  PersonPixels person;
+  person.depth = depth_m;
+  person.distance = personDistanceOf(o, regions, flat, boxes, depth_m, person.mask);
   for (size_t b = 0; b < regions.size(); ++b)
-    if (!flat[b]) markRegion(o, frame, regions[b], silhouette_depth, distance, drop, st);
-  if (distance.empty()) return;
-  st.grown_outside += markGrownOutside(frame, mask, in_any, drop);
-  st.depth_holes += markHolesOutside(frame, distance, o.no_depth_hole_radius_px, in_any, drop);
+    if (!flat[b]) markRegion(o, frame, regions[b], person, drop, st);
+  if (person.distance.empty()) return;
+  st.grown_outside += markGrownOutside(frame, person.mask, in_any, drop);
+  st.depth_holes += markHolesOutside(frame, person.distance, o.no_depth_hole_radius_px, in_any, drop);
 }
 
 // Box modes: the keypoints of each dilated box (in_any) are dropped (detect) or screened.
@@ -581,7 +620,7 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
       for (size_t i = 0; i < n; ++i) r.idx.push_back(static_cast<int>(i));
       std::fill(in_any.begin(), in_any.end(), 1);
       st.iterations += findPerson(*this, frame, r);
-      markRegion(opt_, frame, r, cv::Mat(), cv::Mat(), drop, st);
+      markRegion(opt_, frame, r, PersonPixels(), drop, st);
     } else {
       screenBoxes(*this, frame, boxes, depth_m, in_any, drop, st);
     }

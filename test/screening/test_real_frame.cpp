@@ -126,6 +126,33 @@ TEST(RealFrame, SilhouetteRuleTakesOutlinesAndKeepsDeskAndWall) {
   EXPECT_GE(b.staticRetention(), 0.75);
 }
 
+TEST(RealFrame, DepthProbeTradesOutlineRecallForRetention) {
+  // The depth probe for keypoints without depth (Screening.noDepthProbeRadius, off by default)
+  // on real depth: the hand-annotated people stay dropped and the static regions kept, static
+  // retention rises, but recall on the published mask falls (0.952 -> 0.919 at 8 px): the real
+  // depth is misregistered with the colour, so an outline keypoint's nearest valid depth is
+  // often the background behind the person. This is why the probe is not the default.
+  const Real& r = real();
+  ASSERT_GT(r.frame.size(), 500u);
+  ScreeningOptions o;
+  features::FeatureFrame without = r.frame, with = r.frame;
+  Screener(o).screen(without, r.boxes, r.depth_m);
+  o.no_depth_probe_radius_px = 8;
+  Screener(o).screen(with, r.boxes, r.depth_m);
+  for (const cv::Rect& person : {kRightShirt, kLeftTorso}) {
+    auto c = countIn(with, person);
+    EXPECT_EQ(c.second, c.first) << "person region " << person;
+  }
+  for (const cv::Rect& still : {kMonitor, kPartition, kWallTop}) EXPECT_EQ(countIn(with, still).second, 0);
+  const ScreeningMetrics a = evaluateScreening(without, r.mask, r.boxes);
+  const ScreeningMetrics b = evaluateScreening(with, r.mask, r.boxes);
+  std::printf("real frame, depth probe 8 px: recall %.3f -> %.3f, retention %.3f -> %.3f\n",
+              a.personRecall(), b.personRecall(), a.staticRetention(), b.staticRetention());
+  EXPECT_GT(b.staticRetention(), a.staticRetention() + 0.05);
+  EXPECT_LT(b.personRecall(), a.personRecall());
+  EXPECT_GE(b.personRecall(), 0.90);
+}
+
 TEST(RealFrame, PaperThresholdReadAsSquareMetresSwallowsTheDesk) {
   // nThre = 0.43 m^2 accepts a third point up to sqrt(4.5 * 0.43) = 1.39 m from a tight pair:
   // the sitting person (2 m) merges with the desk and partition (3 m).

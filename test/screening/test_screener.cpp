@@ -522,6 +522,50 @@ TEST(Screener, SilhouetteRuleDropsKeypointsOnThePersonsOutline) {
   EXPECT_EQ(ScreeningOptions::load(Config::fromString("Screening.silhouetteRadius: 5\n", "s.yaml")).silhouette_radius_px, 5.0);
 }
 
+TEST(Screener, DepthProbeKeepsHolesOfTheBackground) {
+  // makeScene's layout over a depth image: wall at 4 m, the person (x 150-249) at 1.5 m, a
+  // 1 px hole on the person's right outline (x 250), the projector's shadow left of the
+  // person (x 140-149) and a large hole (x 100-149, y 60-99) with nothing valid near its middle.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(4.f));
+  depth(cv::Rect(150, 0, 100, 480)).setTo(1.5f);
+  depth(cv::Rect(250, 0, 1, 480)).setTo(0.f);
+  depth(cv::Rect(140, 0, 10, 480)).setTo(0.f);
+  depth(cv::Rect(100, 60, 50, 40)).setTo(0.f);
+  auto scene = [] {
+    Scene s = makeScene();
+    for (cv::Point2f p : {cv::Point2f(250, 200), cv::Point2f(142, 300), cv::Point2f(144, 80)}) {
+      s.frame.keypoints.emplace_back(p, 31.f);
+      s.frame.depth.push_back(0.f);
+    }
+    s.frame.keypoints_un = s.frame.keypoints;
+    return s;
+  };
+  ScreeningOptions o;
+  o.silhouette_radius_px = 0;  // the silhouette rule would take the outline keypoint itself
+  ASSERT_EQ(o.no_depth_probe_radius_px, 0.0);
+  Scene s = scene();
+  const size_t n = s.frame.size();
+  Screener(o).screen(s.frame, s.boxes, depth);
+  // Without the probe near-dynamic drops all three (each is near the person).
+  EXPECT_EQ(s.frame.dynamic[n - 3], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 2], 1);
+  EXPECT_EQ(s.frame.dynamic[n - 1], 1);
+
+  o.no_depth_probe_radius_px = 4;
+  Scene s2 = scene();
+  Screener(o).screen(s2.frame, s2.boxes, depth);
+  EXPECT_EQ(s2.frame.dynamic[n - 3], 1);  // the person's depth 1 px away: the outline
+  EXPECT_EQ(s2.frame.dynamic[n - 2], 0);  // the wall 3 px away, the person 8: the shadow
+  EXPECT_EQ(s2.frame.dynamic[n - 1], 1);  // nothing within 4 px: near-dynamic decides
+
+  // Without the depth image the probe is off.
+  Scene s3 = scene();
+  Screener(o).screen(s3.frame, s3.boxes);
+  EXPECT_EQ(s3.frame.dynamic[n - 2], 1);
+  EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.noDepthProbeRadius: -1\n", "s.yaml")), Error);
+  EXPECT_EQ(ScreeningOptions::load(Config::fromString("Screening.noDepthProbeRadius: 6\n", "s.yaml")).no_depth_probe_radius_px, 6.0);
+}
+
 TEST(OcclusionRule, FindsThePersonBehindAnotherOne) {
   // Person A at 1.5 m, x in [300, 400); person B at 2.5 m behind and to the left, x in
   // [200, 340): A covers B's right part. The wall at 4 m. B's box holds A's left part,

@@ -36,6 +36,9 @@ cv::Mat personDistance(const cv::Mat& mask);
 // The distance of image point p to the person pixels (personDistance sampled at p).
 float distanceAt(const cv::Mat& distance, const cv::Point2f& p);
 
+// Whether image point p lies on a person cell of the mask (false outside it).
+bool personCellAt(const cv::Mat& mask, const cv::Point2f& p);
+
 // Rows (y) and columns (x) of the image per mask cell: the growth works at half resolution, a
 // person's outline moves by more than a pixel between frames anyway.
 constexpr int kPersonMaskStride = 2;

@@ -110,6 +110,14 @@ struct ScreeningOptions {
   // box), Screening.noDepthHoleRadius (pixels; 0 turns both rules and the mask off).
   double grow_outside = 0.25;
   double no_depth_hole_radius_px = 20;
+  // Depth probe for keypoints without depth in a box (needs the depth image and the grown
+  // person mask, so noDepthHoleRadius > 0): the nearest valid depth pixels around the keypoint
+  // (the first square ring within this radius, pixels at level 0 times the keypoint's scale,
+  // that holds any) decide. None on a grown person pixel: the hole is the background's
+  // (projector shadow, far room beyond the sensor's range) and the keypoint stays static.
+  // Nothing valid within the radius: near-dynamic decides as without the probe.
+  // Screening.noDepthProbeRadius (pixels; 0 = off).
+  double no_depth_probe_radius_px = 0;
   double flat_box_fraction = 0.4;
   double flat_box_tolerance = 0.01;
   double flat_box_ring = 0.25;
@@ -127,7 +135,7 @@ struct ScreeningOptions {
   // noDepth (dynamic | static | nearest | near-dynamic), noDepthRadius (px), silhouetteRadius
   // (px), boxDilation, growRadius (px), growDepth (m), clusterMinFraction, dilationDepthOnly,
   // rejectFlatBoxes, flatBoxFraction, flatBoxTolerance (1/m), flatBoxRing, occlusionRule,
-  // occlusionMaxIou, growOutside, noDepthHoleRadius (px), then the keys of
+  // occlusionMaxIou, growOutside, noDepthHoleRadius (px), noDepthProbeRadius (px), then the keys of
   // `tracker` and `temporal`. Invalid values throw yolo_slam::Error naming the file and key.
   static ScreeningOptions load(const Config& cfg);
   // The loader's rules, for options set in code (tracker and temporal included); throws
