@@ -164,6 +164,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Synth.threads",
       "Synth.trajectory",
       "ThDepth",
+      "Tracking.closeMinFrames",
       "Tracking.closeTrackedMax",
       "Tracking.closeUntrackedMin",
       "Tracking.initMinDepthPoints",

@@ -22,6 +22,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.refRatio", &O::ref_ratio, Range::closed(0, 1)},
       {"Tracking.closeTrackedMax", &O::close_tracked_max, Range::atLeast(0)},
       {"Tracking.closeUntrackedMin", &O::close_untracked_min, Range::atLeast(0)},
+      {"Tracking.closeMinFrames", &O::close_min_frames, Range::atLeast(0)},
       {"Tracking.lostResetFrames", &O::lost_reset_frames, Range::atLeast(1)},
       {"Tracking.lostResetMaxKeyFrames", &O::lost_reset_max_keyframes, Range::atLeast(0)},
       {"Tracking.youngMapFrames", &O::young_map_frames, Range::atLeast(1)},

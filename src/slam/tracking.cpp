@@ -234,6 +234,10 @@ bool Tracking::lostYoung() const {
          lost_frames_in_row_ >= opt_.young_lost_reset_frames;
 }
 
+bool Tracking::youngMap(const Frame& F) const {
+  return init_frame_id_ >= 0 && F.id - init_frame_id_ < opt_.young_map_frames;
+}
+
 void Tracking::acceptFrame(const Frame& F, TrackResult& res) {
   ++tracked_;
   last_tracked_id_ = F.id;
@@ -621,7 +625,12 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
     if (F.points[i] && !F.outlier[i]) ++tracked_close;
     else ++untracked_close;
   }
-  const bool need_close = tracked_close < opt_.close_tracked_max && untracked_close > opt_.close_untracked_min;
+  // A young map has few points yet (people covered much of the view while it was made): it
+  // takes a keyframe whenever close points go untracked, a mature one waits closeMinFrames.
+  const int close_gap = youngMap(F) ? 0 : opt_.close_min_frames;
+  const bool need_close = F.id >= last_kf_frame_id_ + close_gap &&
+                          tracked_close < opt_.close_tracked_max &&
+                          untracked_close > opt_.close_untracked_min;
   const double ratio = n_kfs < 2 ? kRefRatioFirst : opt_.ref_ratio;
   const bool c1a = F.id >= last_kf_frame_id_ + max_frames_;
   const bool c1b = F.id >= last_kf_frame_id_ + min_frames_ && idle;

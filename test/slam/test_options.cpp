@@ -115,6 +115,7 @@ Tracking.minFrames: 2
 Tracking.refRatio: 0.875
 Tracking.closeTrackedMax: 90
 Tracking.closeUntrackedMin: 60
+Tracking.closeMinFrames: 7
 Tracking.lostResetFrames: 120
 Tracking.lostResetMaxKeyFrames: 4
 Tracking.youngMapFrames: 45
@@ -260,8 +261,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.init_min_keypoints, k.init_min_depth_points, k.motion_window, k.local_window, k.min_inliers),
             std::make_tuple(400, 80, 12, 4, 25));
   EXPECT_EQ(std::tie(k.max_frames_between_kf, k.min_frames_between_kf, k.ref_ratio, k.close_tracked_max,
-                     k.close_untracked_min),
-            std::make_tuple(20, 2, 0.875, 90, 60));
+                     k.close_untracked_min, k.close_min_frames),
+            std::make_tuple(20, 2, 0.875, 90, 60, 7));
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap),
             std::make_tuple(120, 4, 80, 0.5));
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames), std::make_tuple(45, 3));

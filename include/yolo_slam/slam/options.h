@@ -22,6 +22,8 @@ struct TrackingOptions {
   double ref_ratio = 0.75;          // Tracking.refRatio: keyframe if tracked < ratio * reference's points
   int close_tracked_max = 100;      // Tracking.closeTrackedMax: close-point criterion (tracked < this
   int close_untracked_min = 70;     // Tracking.closeUntrackedMin:  and untracked > this)
+  int close_min_frames = 5;         // Tracking.closeMinFrames: frames since the last keyframe before
+                                    //   the close-point criterion of a mature map may ask for one (0: ORB-SLAM2)
   int lost_reset_frames = 150;      // Tracking.lostResetFrames: lost for this many frames ...
   int lost_reset_max_keyframes = 5; // Tracking.lostResetMaxKeyFrames: ... with a map this small: reset
   // A young map (lost within young_map_frames frames of its initialisation) is reset after

@@ -80,6 +80,8 @@ class Tracking {
   // young_lost_reset_frames.
   bool lostLongInSmallMap() const;
   bool lostYoung() const;
+  // Within young_map_frames of the initialisation of the map F is tracked in.
+  bool youngMap(const Frame& F) const;
   // F becomes the last (good) frame and is recorded in the trajectory.
   void acceptFrame(const Frame& F, TrackResult& res);
   bool initialize(Frame& F);
