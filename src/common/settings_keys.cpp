@@ -169,6 +169,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.closeUntrackedMin",
       "Tracking.initMinDepthPoints",
       "Tracking.initMinKeyPoints",
+      "Tracking.keyFramePoints",
       "Tracking.localWindow",
       "Tracking.lostResetFrames",
       "Tracking.lostResetMaxKeyFrames",

@@ -23,6 +23,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.closeTrackedMax", &O::close_tracked_max, Range::atLeast(0)},
       {"Tracking.closeUntrackedMin", &O::close_untracked_min, Range::atLeast(0)},
       {"Tracking.closeMinFrames", &O::close_min_frames, Range::atLeast(0)},
+      {"Tracking.keyFramePoints", &O::keyframe_points, Range::atLeast(0)},
       {"Tracking.lostResetFrames", &O::lost_reset_frames, Range::atLeast(1)},
       {"Tracking.lostResetMaxKeyFrames", &O::lost_reset_max_keyframes, Range::atLeast(0)},
       {"Tracking.youngMapFrames", &O::young_map_frames, Range::atLeast(1)},

@@ -72,7 +72,6 @@ constexpr double kLocalRatio = 0.8;
 constexpr double kRefRatioFirst = 0.4;
 constexpr double kRefRatioLow = 0.25;
 constexpr int kKeyFrameMinInliers = 15;
-constexpr int kMinClosePoints = 100;       // close points a new keyframe makes map points of
 
 bool finitePose(const Pose& T) { return T.matrix().allFinite(); }
 
@@ -647,7 +646,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
   computeBow(voc_.get(), kf->f);
   ref_kf_ = kf;
   // Close points with depth become map points right away (ORB-SLAM2 CreateNewKeyFrame):
-  // the closest ones first, all those nearer than ThDepth, at least 100.
+  // the closest ones first, all those nearer than ThDepth, at least Tracking.keyFramePoints.
   const std::vector<std::pair<float, int>> by_depth = F.staticByDepth();
   int n = 0;
   for (const auto& e : by_depth) {
@@ -657,7 +656,7 @@ void Tracking::createNewKeyFrame(Frame& F) {
       if (!createDepthPoint(kf, F, i)) continue;
     }
     ++n;
-    if (e.first > cam_.closeDepth() && n > kMinClosePoints) break;
+    if (e.first > cam_.closeDepth() && n > opt_.keyframe_points) break;
   }
   // Map points that now project onto a dynamic keypoint are marked in this keyframe: they are
   // on something that moves and are no longer used for tracking.

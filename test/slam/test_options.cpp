@@ -116,6 +116,7 @@ Tracking.refRatio: 0.875
 Tracking.closeTrackedMax: 90
 Tracking.closeUntrackedMin: 60
 Tracking.closeMinFrames: 7
+Tracking.keyFramePoints: 150
 Tracking.lostResetFrames: 120
 Tracking.lostResetMaxKeyFrames: 4
 Tracking.youngMapFrames: 45
@@ -265,7 +266,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(20, 2, 0.875, 90, 60, 7));
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap),
             std::make_tuple(120, 4, 80, 0.5));
-  EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames), std::make_tuple(45, 3));
+  EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points), std::make_tuple(45, 3, 150));
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size),
             std::make_tuple(12, 8, 0.875, false, 4));

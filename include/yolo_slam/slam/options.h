@@ -24,6 +24,10 @@ struct TrackingOptions {
   int close_untracked_min = 70;     // Tracking.closeUntrackedMin:  and untracked > this)
   int close_min_frames = 5;         // Tracking.closeMinFrames: frames since the last keyframe before
                                     //   the close-point criterion of a mature map may ask for one (0: ORB-SLAM2)
+  // Tracking.keyFramePoints: a new keyframe makes map points of its static keypoints with depth,
+  // the closest first: all nearer than ThDepth and at least this many (ORB-SLAM2: 100). Where
+  // most of the view lies beyond ThDepth (3 m on the TUM cameras) 100 leave a sparse local map.
+  int keyframe_points = 300;
   int lost_reset_frames = 150;      // Tracking.lostResetFrames: lost for this many frames ...
   int lost_reset_max_keyframes = 5; // Tracking.lostResetMaxKeyFrames: ... with a map this small: reset
   // A young map (lost within young_map_frames frames of its initialisation) is reset after
