@@ -28,6 +28,7 @@ const OptionTable<DenseMapOptions>& denseFields() {
       {"DenseMap.probHit", &O::prob_hit, Range::open(0.5, 1)},
       {"DenseMap.probMiss", &O::prob_miss, Range::open(0, 0.5)},
       {"DenseMap.queueSize", &O::queue_size, Range::atLeast(1)},
+      {"DenseMap.threadNice", &O::thread_nice, Range::closed(0, 19)},
       {"DenseMap.finalRebuild", &O::final_rebuild},
       {"DenseMap.maskPeople", &O::mask_people},
   };

@@ -46,6 +46,7 @@ void DenseMapper::start() {
   running_ = true;
   thread_ = std::thread([this] {
     nameThisThread("ys_dense_map");
+    lowerThisThreadPriority(opt_.thread_nice, "DenseMap.threadNice");
     run();
   });
 }

@@ -34,6 +34,7 @@ void LocalMapping::start() {
   stop_ = false;
   if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
     nameThisThread("ys_local_map");
+    lowerThisThreadPriority(opt_.thread_nice, "LocalMapping.threadNice");
     run();
   });
 }
@@ -104,7 +105,8 @@ void LocalMapping::clear() {
   accept_.store(true);
 }
 
-std::vector<double> LocalMapping::timings() const { return lockedCopy(queue_mutex_, timings_); }
+std::vector<double> LocalMapping::timings() const { return phaseTimings().total; }
+LocalMappingTimings LocalMapping::phaseTimings() const { return lockedCopy(queue_mutex_, timings_); }
 size_t LocalMapping::processedKeyFrames() const { return lockedCopy(queue_mutex_, processed_); }
 size_t LocalMapping::culledKeyFrames() const { return lockedCopy(queue_mutex_, culled_); }
 
@@ -145,7 +147,11 @@ void LocalMapping::processFront(std::unique_lock<std::mutex>& lk) {
   const double ms = sw.ms();
   lk.lock();
   busy_ = false;
-  timings_.push_back(ms);
+  timings_.total.push_back(ms);
+  timings_.insert.push_back(phase_insert_);
+  timings_.fuse.push_back(phase_fuse_);
+  timings_.ba.push_back(phase_ba_);
+  timings_.culling.push_back(phase_culling_);
   ++processed_;
   if (queue_.empty()) accept_.store(true);
   cv_.notify_all();
@@ -161,21 +167,31 @@ bool queueEmpty(std::mutex& m, const std::deque<KeyFramePtr>& q) {
 
 void LocalMapping::processOne(const KeyFramePtr& kf) {
   current_ = kf;
+  phase_insert_ = phase_fuse_ = phase_ba_ = phase_culling_ = 0;
+  Stopwatch sw;
   {
     std::lock_guard<std::mutex> lk(map_.update_mutex);
+    sw.restart();
     processNewKeyFrame();
     mapPointCulling();
     createNewMapPoints();
+    phase_insert_ = sw.ms();
   }
   if (queueEmpty(queue_mutex_, queue_)) {
     std::lock_guard<std::mutex> lk(map_.update_mutex);
+    sw.restart();
     searchInNeighbors();
+    phase_fuse_ = sw.ms();
   }
   abort_ba_.store(false);
   if (queueEmpty(queue_mutex_, queue_) && !pauseWanted()) {
+    sw.restart();
     if (opt_.local_ba) localBundleAdjustment();
+    phase_ba_ = sw.ms();
     std::lock_guard<std::mutex> lk(map_.update_mutex);
+    sw.restart();
     keyFrameCulling();
+    phase_culling_ = sw.ms();
   }
   if (loop_closer_) loop_closer_->insertKeyFrame(current_);  // it checks `bad` under the map lock
   current_.reset();

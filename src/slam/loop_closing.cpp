@@ -40,6 +40,7 @@ void LoopClosing::start() {
   running_ = true;
   if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
     nameThisThread("ys_loop_close");
+    lowerThisThreadPriority(opt_.thread_nice, "LoopClosing.threadNice");
     run();
   });
 }
@@ -674,6 +675,7 @@ void LoopClosing::startGlobalBA(long loop_kf_id) {
   if (mode_ == RunMode::Sequential) runGlobalBA(loop_kf_id);
   else gba_thread_ = std::thread([this, loop_kf_id] {
     nameThisThread("ys_global_ba");
+    lowerThisThreadPriority(opt_.thread_nice, "LoopClosing.threadNice");
     runGlobalBA(loop_kf_id);
   });
 }

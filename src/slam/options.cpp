@@ -42,6 +42,7 @@ const OptionTable<LocalMappingOptions>& mappingFields() {
       {"LocalMapping.cullingRedundancy", &O::culling_redundancy, Range::closed(0, 1)},
       {"LocalMapping.localBA", &O::local_ba},
       {"LocalMapping.queueSize", &O::queue_size, Range::atLeast(1)},
+      {"LocalMapping.threadNice", &O::thread_nice, Range::closed(0, 19)},
   };
   return table;
 }
@@ -63,6 +64,7 @@ const OptionTable<LoopClosingOptions>& loopFields() {
       {"LoopClosing.poseGraphIterations", &O::pose_graph_iterations, Range::atLeast(1)},
       {"LoopClosing.globalBA", &O::global_ba},
       {"LoopClosing.globalBAIterations", &O::global_ba_iterations, Range::atLeast(1)},
+      {"LoopClosing.threadNice", &O::thread_nice, Range::closed(0, 19)},
   };
   return table;
 }

@@ -231,8 +231,10 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
   if (shut_down_) return res;
   Stopwatch sw;
   bool reset_requested = false;
+  double lock_wait_ms = 0;
   {
     std::lock_guard<std::mutex> ml(map_->update_mutex);
+    lock_wait_ms = sw.ms();
     res = tracker_->track(frame);
     reset_requested = tracker_->resetRequested();
   }
@@ -241,6 +243,7 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
   {
     std::lock_guard<std::mutex> lk(stats_mutex_);
     stats_.tracking_ms.push_back(ms);
+    stats_.map_lock_wait_ms.push_back(lock_wait_ms);
     ++stats_.frames;
     if (res.state == TrackingState::Ok) ++stats_.tracked;
     else ++stats_.lost;
@@ -435,7 +438,7 @@ SystemStats System::stats() const {
     s.keyframes = map_->numKeyFrames();
     s.map_points = map_->numMapPoints();
   }
-  std::vector<double> lm = mapper_->timings();
+  LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
   size_t relocs = 0;
   {
@@ -449,7 +452,11 @@ SystemStats System::stats() const {
   s = stats_;
   s.keyframes = kf;
   s.map_points = mp;
-  s.local_mapping_ms = std::move(lm);
+  s.local_mapping_ms = std::move(lm.total);
+  s.lm_insert_ms = std::move(lm.insert);
+  s.lm_fuse_ms = std::move(lm.fuse);
+  s.lm_ba_ms = std::move(lm.ba);
+  s.lm_culling_ms = std::move(lm.culling);
   s.keyframes_culled = culled;
   s.relocalizations = relocs;
   s.loops_closed = loops;
@@ -508,7 +515,12 @@ Json statsTimingsJson(const SystemStats& s,
          {"tracking", summaryJsonMs(summarize(s.tracking_ms))},
          {"extraction_plus_tracking", summaryJsonMs(summarize(extractionPlusTrackingMs(s)))},
          {"local_mapping", summaryJsonMs(summarize(s.local_mapping_ms))},
-         {"detection", summaryJsonMs(summarize(s.detection_ms))}};
+         {"detection", summaryJsonMs(summarize(s.detection_ms))},
+         {"map_lock_wait", summaryJsonMs(summarize(s.map_lock_wait_ms))},
+         {"local_mapping_insert", summaryJsonMs(summarize(s.lm_insert_ms))},
+         {"local_mapping_fuse", summaryJsonMs(summarize(s.lm_fuse_ms))},
+         {"local_mapping_ba", summaryJsonMs(summarize(s.lm_ba_ms))},
+         {"local_mapping_culling", summaryJsonMs(summarize(s.lm_culling_ms))}};
   for (const auto& e : extra) t[e.first] = summaryJsonMs(summarize(e.second));
   return t;
 }

@@ -128,6 +128,7 @@ LocalMapping.fuseNeighbours: 8
 LocalMapping.cullingRedundancy: 0.875
 LocalMapping.localBA: 0
 LocalMapping.queueSize: 4
+LocalMapping.threadNice: 3
 LoopClosing.enabled: 0
 LoopClosing.minScore: 0.0625
 LoopClosing.consistency: 4
@@ -141,6 +142,7 @@ LoopClosing.covisibilityWeight: 80
 LoopClosing.poseGraphIterations: 25
 LoopClosing.globalBA: 0
 LoopClosing.globalBAIterations: 8
+LoopClosing.threadNice: 4
 System.sequential: 1
 DenseMap.enabled: 1
 DenseMap.resolution: 0.125
@@ -150,6 +152,7 @@ DenseMap.cloudResolution: 0.03125
 DenseMap.probHit: 0.75
 DenseMap.probMiss: 0.375
 DenseMap.queueSize: 5
+DenseMap.threadNice: 6
 DenseMap.finalRebuild: 0
 DenseMap.maskPeople: 0
 DenseMap.maskMargin: 9
@@ -192,7 +195,9 @@ TEST(Options, EveryKeyIsReadAndDiffersFromItsDefault) {
   cv::FileStorage every(kEveryKey, cv::FileStorage::READ | cv::FileStorage::MEMORY);
   for (const std::string& key : topLevelKeys(every)) {
     ASSERT_TRUE(got.contains(key)) << key << " is not read by any loader";
-    if (def.contains(key)) EXPECT_NE(got[key], def[key]) << key << " keeps its default";
+    if (def.contains(key)) {
+      EXPECT_NE(got[key], def[key]) << key << " keeps its default";
+    }
   }
 }
 
@@ -219,6 +224,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(dm.prob_hit, dm.prob_miss, dm.queue_size, dm.final_rebuild, dm.mask_people, dm.mask.margin_px,
                      dm.mask.sample_stride_px),
             std::make_tuple(0.75, 0.375, 5, false, false, 9, 2));
+  EXPECT_EQ(dm.thread_nice, 6);
 
   const detection::DetectorOptions d = detection::DetectorOptions::load(cfg);
   EXPECT_EQ(d.model, "/tmp/ys_model");
@@ -268,15 +274,17 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(120, 4, 80, 0.5));
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points), std::make_tuple(45, 3, 150));
   const slam::LocalMappingOptions& p = sys.slam.mapping;
-  EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size),
-            std::make_tuple(12, 8, 0.875, false, 4));
+  EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
+                     p.thread_nice),
+            std::make_tuple(12, 8, 0.875, false, 4, 3));
   const slam::LoopClosingOptions& l = sys.slam.loop;
   EXPECT_EQ(std::tie(l.enabled, l.min_score, l.consistency, l.min_keyframes, l.min_bow_matches),
             std::make_tuple(false, 0.0625, 4, 12, 25));
   EXPECT_EQ(std::tie(l.min_ransac_inliers, l.min_matches, l.max_correction_m, l.max_correction_deg),
             std::make_tuple(22, 45, 0.375, 15.0));
-  EXPECT_EQ(std::tie(l.covisibility_weight, l.pose_graph_iterations, l.global_ba, l.global_ba_iterations),
-            std::make_tuple(80, 25, false, 8));
+  EXPECT_EQ(std::tie(l.covisibility_weight, l.pose_graph_iterations, l.global_ba, l.global_ba_iterations,
+                     l.thread_nice),
+            std::make_tuple(80, 25, false, 8, 4));
 }
 
 TEST(Options, TheShippedSettingsLoadWithTheDefaults) {
@@ -326,6 +334,8 @@ TEST(Options, RejectionsNameFileKeyRuleAndValue) {
             "bad.yaml: key 'Tracking.refRatio' must be in [0, 1] (got 1.5)");
   EXPECT_EQ(systemRejection("LocalMapping.queueSize", "0"),
             "bad.yaml: key 'LocalMapping.queueSize' must be >= 1 (got 0)");
+  EXPECT_EQ(systemRejection("LocalMapping.threadNice", "20"),
+            "bad.yaml: key 'LocalMapping.threadNice' must be in [0, 19] (got 20)");
   EXPECT_EQ(systemRejection("LoopClosing.maxCorrectionDeg", "190"),
             "bad.yaml: key 'LoopClosing.maxCorrectionDeg' must be in [0, 180] (got 190)");
   EXPECT_EQ(systemRejection("ORBextractor.scaleFactor", "1.0"),

@@ -7,4 +7,10 @@ namespace yolo_slam {
 // At most 15 characters are kept (the kernel's limit); a failure is ignored.
 void nameThisThread(const char* name);
 
+// Raises the calling thread's nice value by `delta` (0..19) above the process's, so that on a
+// busy machine the scheduler gives the frame thread precedence over background work (Linux:
+// nice is per thread). When the kernel refuses, logs a warning naming `option_key` (the
+// setting that asked for it) and the thread runs unchanged.
+void lowerThisThreadPriority(int delta, const char* option_key);
+
 }  // namespace yolo_slam

@@ -49,6 +49,8 @@ struct DenseMapOptions {
   double prob_miss = kDefaultProbMiss;               // DenseMap.probMiss
   int queue_size = kDefaultQueueSize;                // DenseMap.queueSize: keyframes waiting;
                                                      // when full the oldest waiting is dropped
+  int thread_nice = 10;                              // DenseMap.threadNice: the mapper thread's
+                                                     // nice value above the process's
   bool final_rebuild = true;                         // DenseMap.finalRebuild: at the end, all
                                                      // keyframes again with their final poses
   bool mask_people = true;                           // DenseMap.maskPeople: 0 integrates every

@@ -24,6 +24,16 @@ namespace slam {
 
 class LoopClosing;
 
+// Milliseconds per processed keyframe, whole (waits included) and by phase (the time a phase
+// holds the map lock, which holds up Tracking; the bundle adjustment runs without the lock).
+struct LocalMappingTimings {
+  std::vector<double> total;
+  std::vector<double> insert;  // under the map lock: associate, cull recent points, triangulate
+  std::vector<double> fuse;    // under the map lock: searchInNeighbors (skipped while busy)
+  std::vector<double> ba;      // local BA without the lock, plus its write-back under it
+  std::vector<double> culling; // under the map lock: keyframe culling
+};
+
 class LocalMapping {
  public:
   LocalMapping(Map& map, const CameraModel& cam, const LocalMappingOptions& opt,
@@ -68,6 +78,7 @@ class LocalMapping {
 
   // Milliseconds per processed keyframe (copy; thread-safe).
   std::vector<double> timings() const;
+  LocalMappingTimings phaseTimings() const;
   size_t processedKeyFrames() const;
   size_t culledKeyFrames() const;
 
@@ -105,7 +116,7 @@ class LocalMapping {
   bool busy_ = false;
   bool paused_ack_ = false;
   bool stop_ = false;
-  std::vector<double> timings_;
+  LocalMappingTimings timings_;
   size_t processed_ = 0, culled_ = 0;
 
   std::atomic<bool> accept_{true};
@@ -119,6 +130,8 @@ class LocalMapping {
   // or in Sequential mode the caller of processQueued).
   KeyFramePtr current_;
   std::list<MapPointPtr> recent_points_;
+  // Phase times of the keyframe in progress (0 for a phase it skipped).
+  double phase_insert_ = 0, phase_fuse_ = 0, phase_ba_ = 0, phase_culling_ = 0;
 };
 
 }  // namespace slam

@@ -73,6 +73,10 @@ struct SystemStats {
   BoxCounts boxes;
   double feature_budget_sum = 0;  // per frame nFeatures multiples extracted (ORBextractor.dynamicBoostMax)
   std::vector<double> extraction_ms, screening_ms, tracking_ms, local_mapping_ms, detection_ms;
+  // Per frame: how long Tracking waited for the map lock (part of tracking_ms).
+  std::vector<double> map_lock_wait_ms;
+  // Per processed keyframe, by phase (LocalMappingTimings; total is local_mapping_ms).
+  std::vector<double> lm_insert_ms, lm_fuse_ms, lm_ba_ms, lm_culling_ms;
 };
 
 // Per frame: extraction_ms + tracking_ms (the tracking thread's share of a frame).
@@ -84,7 +88,8 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 // feature_budget_mean (nFeatures multiples extracted, mean over the frames).
 Json statsCountsJson(const SystemStats& s);
 // Per stage {"count", "median_ms", "mean_ms", "p95_ms"}: extraction, screening, tracking,
-// extraction_plus_tracking, local_mapping, detection, then `extra` stages measured by the caller.
+// extraction_plus_tracking, local_mapping, detection, map_lock_wait and the local-mapping
+// phases (local_mapping_insert, _fuse, _ba, _culling), then `extra` stages measured by the caller.
 Json statsTimingsJson(const SystemStats& s,
                       const std::vector<std::pair<std::string, std::vector<double>>>& extra = {});
 
