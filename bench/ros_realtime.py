@@ -20,6 +20,7 @@ import time
 
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import PoseStamped
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -60,6 +61,11 @@ def main():
         for st in msg.status:
             diag[st.name] = {kv.key: kv.value for kv in st.values}
 
+    poses_seen = []  # (image stamp, ROS clock on arrival) of every pose message, seconds
+
+    def on_pose(msg):
+        poses_seen.append((msg.header.stamp.to_sec(), rospy.get_rostime().to_sec()))
+
     def slam_diag():
         return next((v for k, v in diag.items() if "slam" in k and "tracking" in k), {})
 
@@ -67,6 +73,7 @@ def main():
         time.sleep(2.0)  # the master
         rospy.init_node("ros_realtime_bench", anonymous=True, disable_signals=True)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag)
+        rospy.Subscriber("/yolo_slam/pose", PoseStamped, on_pose, queue_size=1000, tcp_nodelay=True)
         play_s = frames / 30.0 / a.rate
         deadline = time.time() + 60 + START_DELAY_S + play_s * 3
         last_received, last_change = -1, time.time()
@@ -104,6 +111,10 @@ def main():
         "slam": s, "screening": scr, "ate_rmse_m": ate,
         "load": open("/proc/loadavg").read().split()[:3],
     }
+    with open(os.path.join(a.out, "pose_latency.txt"), "w") as f:
+        f.write("# image_stamp_s latency_ms (ROS clock when the pose message arrived here, minus the stamp)\n")
+        for stamp, now in poses_seen:
+            f.write("%.6f %.1f\n" % (stamp, (now - stamp) * 1000.0))
     with open(os.path.join(a.out, "ros_realtime.json"), "w") as f:
         json.dump(result, f, indent=2)
     print(json.dumps(result, indent=2))

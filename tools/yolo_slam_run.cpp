@@ -397,7 +397,8 @@ void setUpBoxes(const Args& args, RunSetup& r) {
     r.boxes_source = dopt.model;
     for (const auto& m : dopt.extra_models) r.boxes_source += " + " + m;
     if (aopt.enabled) {
-      r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector), aopt.min_interval_s);
+      r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector), aopt.min_interval_s,
+                                                          aopt.thread_nice);
       r.max_box_age_s = aopt.max_age_s;
       r.boxes_source += " (async)";
     }

@@ -16,14 +16,16 @@ AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
   o.max_age_s = readDouble(cfg, "Detection.maxAge", o.max_age_s, Range::atLeast(0));
   o.threads = readInt(cfg, "Detection.asyncThreads", o.threads, Range::closed(1, DetectorOptions::kMaxThreads));
   o.min_interval_s = readDouble(cfg, "Detection.asyncMinInterval", o.min_interval_s, Range::atLeast(0));
+  o.thread_nice = readInt(cfg, "Detection.threadNice", o.thread_nice, Range::closed(0, 19));
   return o;
 }
 
-AsyncDetector::AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s)
+AsyncDetector::AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s, int thread_nice)
     : detector_(std::move(detector)), min_interval_s_(min_interval_s) {
   if (!detector_) throw Error("AsyncDetector needs a detector");
-  worker_ = std::thread([this] {
+  worker_ = std::thread([this, thread_nice] {
     nameThisThread("ys_detect");
+    lowerThisThreadPriority(thread_nice, "Detection.threadNice");
     run();
   });
 }

@@ -4,6 +4,7 @@
 #include <dynamic_reconfigure/server.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
@@ -14,6 +15,7 @@
 #include "yolo_slam/BoundingBoxes.h"
 #include "yolo_slam/DetectorConfig.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/common/thread_name.h"
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/detection/async_detector.h"
 #include "yolo_slam/detection/detector.h"
@@ -23,6 +25,11 @@ namespace yolo_slam {
 namespace ros1 {
 
 class DetectorNodelet : public nodelet::Nodelet {
+ public:
+  ~DetectorNodelet() override {
+    if (image_spinner_) image_spinner_->stop();
+  }
+
  private:
   using ReconfigureServer = dynamic_reconfigure::Server<DetectorConfig>;
   static constexpr double kStatsPeriodS = 10.0;
@@ -48,12 +55,22 @@ class DetectorNodelet : public nodelet::Nodelet {
     NODELET_INFO("Detector: input queue %d (%s)%s", input_queue,
                  input_queue == 1 ? "newest image when free" : "every image",
                  async_.min_interval_s > 0 ? ", at most one image per Detection.asyncMinInterval" : "");
-    sub_ = nh.subscribe(kRgbTopic, input_queue, &DetectorNodelet::onImage, this,
-                        ::ros::TransportHints().tcpNoDelay());
+    subscribeImages(nh, input_queue);
     stats_timer_ = nh.createWallTimer(::ros::WallDuration(kStatsPeriodS),
                                       [this](const ::ros::WallTimerEvent&) { logStats(); });
     diagnostics_.begin(nh, pnh, getName()).add("detection", this, &DetectorNodelet::fillDiagnostics);
     diagnostics_.run(nh);
+  }
+
+  // Images are detected on a thread of this nodelet's own (not the manager's shared workers),
+  // niced by Detection.threadNice so that the frame stream's nodelets go first on a busy CPU.
+  void subscribeImages(const ::ros::NodeHandle& nh, int input_queue) {
+    ::ros::NodeHandle image_nh(nh);
+    image_nh.setCallbackQueue(&image_queue_);
+    sub_ = image_nh.subscribe(kRgbTopic, input_queue, &DetectorNodelet::onImage, this,
+                              ::ros::TransportHints().tcpNoDelay());
+    image_spinner_ = std::make_unique<::ros::AsyncSpinner>(1, &image_queue_);
+    image_spinner_->start();
   }
 
   void fillDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st) {
@@ -124,6 +141,11 @@ class DetectorNodelet : public nodelet::Nodelet {
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& img) {
+    if (!thread_niced_) {
+      nameThisThread("ys_detect");
+      lowerThisThreadPriority(async_.enabled ? async_.thread_nice : 0, "Detection.threadNice");
+      thread_niced_ = true;
+    }
     if (throttled(img->header.stamp)) {
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++throttled_;
@@ -181,6 +203,9 @@ class DetectorNodelet : public nodelet::Nodelet {
   ::ros::Time last_detected_;  // image callback only (its callbacks are serialised)
   boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure's own config lock
   std::unique_ptr<ReconfigureServer> reconfigure_;
+  ::ros::CallbackQueue image_queue_;  // onImage only, served by image_spinner_'s one thread
+  std::unique_ptr<::ros::AsyncSpinner> image_spinner_;
+  bool thread_niced_ = false;  // onImage's thread only
   ::ros::Subscriber sub_;
   ::ros::Publisher pub_;
   ::ros::WallTimer stats_timer_;

@@ -4,7 +4,10 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/detection/async_detector.h"
 
+#include "support/thread_nice.h"
+
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
@@ -97,6 +100,22 @@ TEST(AsyncDetector, AMinimumIntervalKeepsFramesFromTheDetector) {
   async.waitIdle();
   EXPECT_EQ(async.counts().detected, 11);
   EXPECT_EQ(async.newest()->frame, 30);
+}
+
+TEST(AsyncDetector, TheDetectionThreadRunsAtDetectionThreadNice) {
+  const int base = getpriority(PRIO_PROCESS, 0);
+  AsyncDetector async(std::make_unique<InstantDetector>(), 0, 6);
+  const int expected = test_support::niceAbove(base, 6);
+  EXPECT_EQ(test_support::waitForThreadNice("ys_detect", expected), expected);
+}
+
+TEST(AsyncDetector, DetectionThreadNiceIsReadAndBounded) {
+  Config cfg;
+  cfg.set("Detection.threadNice", "4");
+  EXPECT_EQ(AsyncDetectionOptions::load(cfg).thread_nice, 4);
+  EXPECT_EQ(AsyncDetectionOptions::load(Config()).thread_nice, 0);
+  cfg.set("Detection.threadNice", "25");
+  EXPECT_THROW(AsyncDetectionOptions::load(cfg), Error);
 }
 
 TEST(BoxFeed, AResultServesOneFrameAndExpires) {

@@ -39,6 +39,10 @@ struct AsyncDetectionOptions {
   // only this long after the last frame it took. 0 detects whenever the detector is free; more
   // leaves CPU to the rest of the pipeline at the cost of carrying boxes over more frames.
   double min_interval_s = 0;
+  // Detection.threadNice: the detection thread's nice value above the process's (asynchronous
+  // detection: the offline runner's worker, the Detector nodelet's own thread), so that on a
+  // busy CPU the frame stream goes first; the boxes then come less often.
+  int thread_nice = 0;
   static AsyncDetectionOptions load(const Config& cfg);  // throws Error naming file and key
 };
 
@@ -57,7 +61,7 @@ struct AsyncDetectionCounts {
 
 class AsyncDetector {
  public:
-  explicit AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s = 0);
+  explicit AsyncDetector(std::unique_ptr<Detector> detector, double min_interval_s = 0, int thread_nice = 0);
   ~AsyncDetector();  // finishes the frame in progress, then stops
   AsyncDetector(const AsyncDetector&) = delete;
   AsyncDetector& operator=(const AsyncDetector&) = delete;
