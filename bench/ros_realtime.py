@@ -14,6 +14,7 @@ import argparse
 import json
 import os
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -34,6 +35,13 @@ def frames_in(seq):
         return sum(1 for line in f if line.strip() and not line.startswith("#"))
 
 
+def write_latencies(path, seen, what):
+    with open(path, "w") as f:
+        f.write("# image_stamp_s latency_ms (ROS clock when the %s message arrived here, minus the stamp)\n" % what)
+        for stamp, now in seen:
+            f.write("%.6f %.1f\n" % (stamp, (now - stamp) * 1000.0))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("seq")
@@ -41,6 +49,9 @@ def main():
     ap.add_argument("--rate", type=float, default=1.0)
     ap.add_argument("--out", default="/tmp/yolo_slam_ros_realtime")
     ap.add_argument("--launch-arg", action="append", default=[])
+    ap.add_argument("--stage-latency", action="store_true",
+                    help="also record the Screening nodelet's output (yolo_slam/keypoint_frame) per message "
+                         "in OUT/keypoint_frame_latency.txt; the graph then serialises it for this process")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     bag = a.bag or os.path.join(a.out, "sequence.bag")
@@ -66,6 +77,12 @@ def main():
     def on_pose(msg):
         poses_seen.append((msg.header.stamp.to_sec(), rospy.get_rostime().to_sec()))
 
+    frames_seen = []  # the same for the keypoint frames (--stage-latency)
+
+    def on_frame(msg):
+        _, secs, nsecs = struct.unpack_from("<III", msg._buff, 0)  # std_msgs/Header: seq, stamp
+        frames_seen.append((secs + nsecs * 1e-9, rospy.get_rostime().to_sec()))
+
     def slam_diag():
         return next((v for k, v in diag.items() if "slam" in k and "tracking" in k), {})
 
@@ -74,6 +91,8 @@ def main():
         rospy.init_node("ros_realtime_bench", anonymous=True, disable_signals=True)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag)
         rospy.Subscriber("/yolo_slam/pose", PoseStamped, on_pose, queue_size=1000, tcp_nodelay=True)
+        if a.stage_latency:
+            rospy.Subscriber("/yolo_slam/keypoint_frame", rospy.AnyMsg, on_frame, queue_size=1000, tcp_nodelay=True)
         play_s = frames / 30.0 / a.rate
         deadline = time.time() + 60 + START_DELAY_S + play_s * 3
         last_received, last_change = -1, time.time()
@@ -111,10 +130,9 @@ def main():
         "slam": s, "screening": scr, "ate_rmse_m": ate,
         "load": open("/proc/loadavg").read().split()[:3],
     }
-    with open(os.path.join(a.out, "pose_latency.txt"), "w") as f:
-        f.write("# image_stamp_s latency_ms (ROS clock when the pose message arrived here, minus the stamp)\n")
-        for stamp, now in poses_seen:
-            f.write("%.6f %.1f\n" % (stamp, (now - stamp) * 1000.0))
+    write_latencies(os.path.join(a.out, "pose_latency.txt"), poses_seen, "pose")
+    if a.stage_latency:
+        write_latencies(os.path.join(a.out, "keypoint_frame_latency.txt"), frames_seen, "keypoint frame")
     with open(os.path.join(a.out, "ros_realtime.json"), "w") as f:
         json.dump(result, f, indent=2)
     print(json.dumps(result, indent=2))
