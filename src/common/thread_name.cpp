@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <exception>
+#include <thread>
 
 #include <cstring>
 #include <string>
@@ -30,6 +32,25 @@ void lowerThisThreadPriority(int delta, const char* option_key) {
   if (errno == 0 && setpriority(PRIO_PROCESS, tid, std::min(kNiceMax, now + delta)) == 0) return;
   log::warn("%s %d: could not raise the thread's nice value (%s); it keeps the process's priority",
             option_key, delta, std::strerror(errno));
+}
+
+void runAtLowerPriority(int delta, const char* name, const char* option_key, const std::function<void()>& work) {
+  if (delta <= 0) {
+    work();
+    return;
+  }
+  std::exception_ptr failure;
+  std::thread worker([&] {
+    nameThisThread(name);
+    lowerThisThreadPriority(delta, option_key);
+    try {
+      work();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  });
+  worker.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace yolo_slam

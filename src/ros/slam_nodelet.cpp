@@ -375,6 +375,9 @@ class SlamNodelet : public nodelet::Nodelet {
     st.add("awaiting_camera_info", awaiting_camera_info_.load());
     st.add("out_of_order", out_of_order_.load());
     st.add("track_median_ms", track.median);
+    st.add("track_p95_ms", track.p95);
+    st.add("track_max_ms", track.max);
+    st.add("map_lock_wait_max_ms", live.map_lock_wait_max_ms);
     st.add("message_conversion_median_ms", conversion.median);
     st.add("local_mapping_median_ms", live.local_mapping_median_ms);
     st.add("keyframes", live.keyframes);

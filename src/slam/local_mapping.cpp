@@ -34,7 +34,6 @@ void LocalMapping::start() {
   stop_ = false;
   if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
     nameThisThread("ys_local_map");
-    lowerThisThreadPriority(opt_.thread_nice, "LocalMapping.threadNice");
     run();
   });
 }
@@ -485,7 +484,11 @@ void LocalMapping::localBundleAdjustment() {
     w = localWindow(current_);
   }
   if (w.problem.observations.empty() || abort_ba_.load()) return;
-  const optimization::BaResult result = optimization::localBundleAdjustment(cam_, w.problem, abort_ba_);
+  // Only the solve runs niced (LocalMapping.threadNice): the other phases hold the map lock.
+  optimization::BaResult result;
+  const int nice = mode_ == RunMode::Threaded ? opt_.thread_nice : 0;
+  runAtLowerPriority(nice, "ys_local_ba", "LocalMapping.threadNice",
+                     [&] { result = optimization::localBundleAdjustment(cam_, w.problem, abort_ba_); });
   std::lock_guard<std::mutex> lk(map_.update_mutex);
   writeBackLocalWindow(map_, w, result);
 }

@@ -40,7 +40,6 @@ void LoopClosing::start() {
   running_ = true;
   if (mode_ == RunMode::Threaded) thread_ = std::thread([this] {
     nameThisThread("ys_loop_close");
-    lowerThisThreadPriority(opt_.thread_nice, "LoopClosing.threadNice");
     run();
   });
 }
@@ -675,7 +674,6 @@ void LoopClosing::startGlobalBA(long loop_kf_id) {
   if (mode_ == RunMode::Sequential) runGlobalBA(loop_kf_id);
   else gba_thread_ = std::thread([this, loop_kf_id] {
     nameThisThread("ys_global_ba");
-    lowerThisThreadPriority(opt_.thread_nice, "LoopClosing.threadNice");
     runGlobalBA(loop_kf_id);
   });
 }
@@ -698,7 +696,11 @@ void LoopClosing::runGlobalBA(long loop_kf_id) {
   }
   optimization::BaResult res;
   try {
-    res = optimization::globalBundleAdjustment(cam_, problem, opt_.global_ba_iterations, gba_stop_);
+    // Only the solve runs niced (LoopClosing.threadNice): it holds no lock.
+    const int nice = mode_ == RunMode::Threaded ? opt_.thread_nice : 0;
+    runAtLowerPriority(nice, "ys_global_ba_s", "LoopClosing.threadNice", [&] {
+      res = optimization::globalBundleAdjustment(cam_, problem, opt_.global_ba_iterations, gba_stop_);
+    });
   } catch (const std::exception& e) {
     log::warn("global BA after loop at keyframe %ld failed: %s", loop_kf_id, e.what());
     gba_running_.store(false);

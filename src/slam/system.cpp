@@ -428,6 +428,12 @@ LiveCounts System::liveCounts() const {
     c.map_points = map_->numMapPoints();
   }
   c.local_mapping_median_ms = summarize(mapper_->timings()).median;
+  // The frames of the last ten seconds at 30 Hz: what a monitor polling every second sees.
+  constexpr size_t kRecentFrames = 300;
+  std::lock_guard<std::mutex> lk(stats_mutex_);
+  const std::vector<double>& waits = stats_.map_lock_wait_ms;
+  const size_t from = waits.size() > kRecentFrames ? waits.size() - kRecentFrames : 0;
+  for (size_t k = from; k < waits.size(); ++k) c.map_lock_wait_max_ms = std::max(c.map_lock_wait_max_ms, waits[k]);
   return c;
 }
 

@@ -1,5 +1,5 @@
 // Per-thread priority: lowerThisThreadPriority raises the nice value of the calling thread only,
-// capped at the kernel's maximum.
+// capped at the kernel's maximum; runAtLowerPriority runs work on such a thread and waits.
 #include "yolo_slam/common/thread_name.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <thread>
 
 namespace yolo_slam {
@@ -34,6 +35,18 @@ TEST(ThreadPriority, OnlyTheCallingThreadIsLowered) {
 }
 
 TEST(ThreadPriority, TheNiceValueIsCappedAtTheMaximum) { EXPECT_EQ(niceAfterLowering(19), 19); }
+
+TEST(ThreadPriority, RunAtLowerPriorityRunsNicedAndWaits) {
+  const int before = niceOfThisThread();
+  int nice = -100;
+  runAtLowerPriority(5, "ys_test", "Test.threadNice", [&] { nice = niceOfThisThread(); });
+  EXPECT_EQ(nice, std::min(19, before + 5));
+  EXPECT_EQ(niceOfThisThread(), before);
+  runAtLowerPriority(0, "ys_test", "Test.threadNice", [&] { nice = niceOfThisThread(); });
+  EXPECT_EQ(nice, before);  // in the caller's thread
+  EXPECT_THROW(runAtLowerPriority(5, "ys_test", "Test.threadNice", [] { throw std::runtime_error("x"); }),
+               std::runtime_error);
+}
 
 }  // namespace
 }  // namespace yolo_slam

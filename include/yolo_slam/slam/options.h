@@ -49,8 +49,8 @@ struct LocalMappingOptions {
                                       // of its points is seen by >= 3 other keyframes
   bool local_ba = true;               // LocalMapping.localBA
   int queue_size = 3;                 // LocalMapping.queueSize: bounded keyframe queue
-  int thread_nice = 10;               // LocalMapping.threadNice: the mapping thread's nice value
-                                      // above the process's (0: same priority as tracking)
+  int thread_nice = 10;               // LocalMapping.threadNice: the local BA's solve runs on a
+                                      // helper thread this much nicer than the process (0: inline)
 
   static LocalMappingOptions load(const Config& cfg);
 };
@@ -70,8 +70,8 @@ struct LoopClosingOptions {
   int covisibility_weight = 100;     // LoopClosing.covisibilityWeight: essential-graph covisibility edges
   int pose_graph_iterations = 20;    // LoopClosing.poseGraphIterations
   bool global_ba = true;             // LoopClosing.globalBA: full BA in its own thread after a loop
-  int thread_nice = 10;              // LoopClosing.threadNice: nice value of the loop-closing and
-                                     // global-BA threads above the process's
+  int thread_nice = 10;              // LoopClosing.threadNice: the global BA's solve runs on a
+                                     // helper thread this much nicer than the process
   int global_ba_iterations = 10;     // LoopClosing.globalBAIterations
 
   static LoopClosingOptions load(const Config& cfg);

@@ -60,6 +60,7 @@ void to_json(Json& j, const BoxCounts& b);  // {"detected", "tracked"}
 struct LiveCounts {
   size_t keyframes = 0, map_points = 0;
   double local_mapping_median_ms = 0;  // per keyframe processed so far
+  double map_lock_wait_max_ms = 0;     // longest wait of Tracking for the map lock, last frames
 };
 
 struct SystemStats {
