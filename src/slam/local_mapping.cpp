@@ -169,17 +169,17 @@ void LocalMapping::processOne(const KeyFramePtr& kf) {
   phase_insert_ = phase_fuse_ = phase_ba_ = phase_culling_ = 0;
   Stopwatch sw;
   {
-    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    std::unique_lock<std::mutex> lk(map_.update_mutex);
     sw.restart();
     processNewKeyFrame();
     mapPointCulling();
-    createNewMapPoints();
+    createNewMapPoints(lk);
     phase_insert_ = sw.ms();
   }
   if (queueEmpty(queue_mutex_, queue_)) {
-    std::lock_guard<std::mutex> lk(map_.update_mutex);
+    std::unique_lock<std::mutex> lk(map_.update_mutex);
     sw.restart();
-    searchInNeighbors();
+    searchInNeighbors(lk);
     phase_fuse_ = sw.ms();
   }
   abort_ba_.store(false);
@@ -345,14 +345,15 @@ bool triangulateMatch(const CameraModel& cam, const View& v1, const View& v2, si
 
 }  // namespace
 
-void LocalMapping::createNewMapPoints() {
+void LocalMapping::createNewMapPoints(std::unique_lock<std::mutex>& map_lock) {
   const KeyFramePtr& kf1 = current_;
   const std::vector<KeyFramePtr> neigh = kf1->bestCovisibles(opt_.triangulation_neighbours);
   const View v1 = viewOf(*kf1);
   const Eigen::Matrix3d K = (Eigen::Matrix3d() << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1).finished();
   const Eigen::Matrix3d Kinv = K.inverse();
   for (const KeyFramePtr& kf2 : neigh) {
-    if (kf2->bad) continue;
+    if (kf2 != neigh.front()) map_.yieldToTracking(map_lock);
+    if (kf2->bad || current_->bad) continue;
     if (!queueEmpty(queue_mutex_, queue_) && kf2 != neigh.front()) break;
     const View v2 = viewOf(*kf2);
     if ((v2.O - v1.O).norm() < cam_.baseline()) continue;
@@ -372,7 +373,7 @@ void LocalMapping::createNewMapPoints() {
   }
 }
 
-void LocalMapping::searchInNeighbors() {
+void LocalMapping::searchInNeighbors(std::unique_lock<std::mutex>& map_lock) {
   const KeyFramePtr& cur = current_;
   if (cur->bad) return;
   std::vector<KeyFramePtr> targets;
@@ -389,7 +390,13 @@ void LocalMapping::searchInNeighbors() {
       if (!kf2->bad && seen.insert(kf2->id).second) targets.push_back(kf2);
 
   std::vector<MapPointPtr> cur_points = cur->mapPoints();
-  for (const auto& kf : targets) matcher::fuse(map_, kf, cur_points);
+  for (const auto& kf : targets) {
+    map_.yieldToTracking(map_lock);
+    if (cur->bad) return;
+    if (!kf->bad) matcher::fuse(map_, kf, cur_points);
+  }
+  map_.yieldToTracking(map_lock);
+  if (cur->bad) return;
 
   std::vector<MapPointPtr> candidates;
   std::set<long> cand_ids;

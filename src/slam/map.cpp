@@ -3,8 +3,10 @@
 #include "yolo_slam/vocabulary/keyframe_database.h"
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <map>
+#include <thread>
 
 namespace yolo_slam {
 namespace slam {
@@ -139,6 +141,23 @@ std::vector<KeyFramePtr> Map::keyframes() const {
 
 std::vector<MapPointPtr> Map::mapPoints() const {
   return std::vector<MapPointPtr>(points_.begin(), points_.end());
+}
+
+std::unique_lock<std::mutex> Map::lockForTracking() {
+  tracking_waiting_.fetch_add(1);
+  std::unique_lock<std::mutex> lk(update_mutex);
+  tracking_waiting_.fetch_sub(1);
+  return lk;
+}
+
+void Map::yieldToTracking(std::unique_lock<std::mutex>& lk) {
+  if (tracking_waiting_.load() == 0) return;
+  // Unlocking alone is not a handover (the releasing thread may take the mutex straight back):
+  // wait until Tracking holds it.
+  constexpr auto kPoll = std::chrono::microseconds(100);
+  lk.unlock();
+  while (tracking_waiting_.load() > 0) std::this_thread::sleep_for(kPoll);
+  lk.lock();
 }
 
 void Map::clear() {

@@ -233,7 +233,7 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
   bool reset_requested = false;
   double lock_wait_ms = 0;
   {
-    std::lock_guard<std::mutex> ml(map_->update_mutex);
+    std::unique_lock<std::mutex> ml = map_->lockForTracking();
     lock_wait_ms = sw.ms();
     res = tracker_->track(frame);
     reset_requested = tracker_->resetRequested();

@@ -7,7 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <random>
+#include <thread>
 
 using namespace yolo_slam;
 using namespace yolo_slam::slam;
@@ -100,6 +103,28 @@ void expectConsistent(const Map& map) {
 }
 
 }  // namespace
+
+// A holder of the map lock hands it to a waiting Tracking between the parts of a step, and
+// keeps it when nobody waits.
+TEST(SlamMap, YieldToTrackingHandsTheLockOverOnlyWhenTrackingWaits) {
+  Map map;
+  std::unique_lock<std::mutex> mapper(map.update_mutex);
+  map.yieldToTracking(mapper);  // nobody waits: a no-op
+  EXPECT_TRUE(mapper.owns_lock());
+  std::atomic<bool> tracked{false};
+  std::thread tracking([&] {
+    std::unique_lock<std::mutex> lk = map.lockForTracking();
+    tracked = true;
+  });
+  // Until the mapper yields, Tracking waits; the yield returns only after Tracking's frame.
+  while (!tracked) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    map.yieldToTracking(mapper);
+  }
+  EXPECT_TRUE(mapper.owns_lock());
+  mapper.unlock();
+  tracking.join();
+}
 
 TEST(SlamMap, CovisibilityWeightsAndTree) {
   Fixture fx;

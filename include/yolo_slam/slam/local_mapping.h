@@ -24,8 +24,9 @@ namespace slam {
 
 class LoopClosing;
 
-// Milliseconds per processed keyframe, whole (waits included) and by phase (the time a phase
-// holds the map lock, which holds up Tracking; the bundle adjustment runs without the lock).
+// Milliseconds per processed keyframe, whole (waits included) and by phase (from taking the map
+// lock to letting it go, including the frames it yields to Tracking; the bundle adjustment
+// runs without the lock).
 struct LocalMappingTimings {
   std::vector<double> total;
   std::vector<double> insert;  // under the map lock: associate, cull recent points, triangulate
@@ -97,8 +98,9 @@ class LocalMapping {
   void releasePause(std::atomic<bool>& flag);
   void processNewKeyFrame();
   void mapPointCulling();
-  void createNewMapPoints();
-  void searchInNeighbors();
+  // Both hold the map lock (map_lock) and yield it to Tracking between neighbour keyframes.
+  void createNewMapPoints(std::unique_lock<std::mutex>& map_lock);
+  void searchInNeighbors(std::unique_lock<std::mutex>& map_lock);
   void localBundleAdjustment();
   void keyFrameCulling();
 

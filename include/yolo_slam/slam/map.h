@@ -15,7 +15,8 @@
 // LOCKING. One coarse mutex, `update_mutex`, guards the whole map graph: the Map's sets and every
 // mutable member of every KeyFrame and MapPoint (poses, positions, associations, covisibility,
 // tree, flags, counters). Tracking holds it for the whole processing of a frame; LocalMapping
-// holds it for each step of a keyframe, but releases it while Ceres solves the local bundle
+// holds it for each step of a keyframe, hands it to a waiting Tracking between the parts of a
+// long step (yieldToTracking), and releases it while Ceres solves the local bundle
 // adjustment on a copy (BaProblem) and re-takes it to write the result back; System takes it for
 // snapshots/trajectories. LoopClosing holds it for loop detection + verification, for the whole
 // correction (pose propagation, fusion, essential graph) and for the global-BA copy/write-back,
@@ -47,6 +48,14 @@ class Map {
 
   // Guards everything described above. Lock order: update_mutex first.
   mutable std::mutex update_mutex;
+
+  // update_mutex for Tracking: the caller counts as waiting until it holds the lock, so that
+  // a holder in a long step can let it go first (a frame should not wait for a whole step).
+  std::unique_lock<std::mutex> lockForTracking();
+  // Called with update_mutex held (lk), between parts of a step that need not be atomic
+  // together: when Tracking waits, releases the lock until Tracking has taken it, then takes it
+  // back (after Tracking's frame). The caller must re-check `bad` on what it holds afterwards.
+  void yieldToTracking(std::unique_lock<std::mutex>& lk);
 
   // Ids are unique over the map's lifetime (not reused after clear()); atomic so they can be
   // drawn without the mutex.
@@ -97,6 +106,7 @@ class Map {
   void adopt(Map& other);
 
  private:
+  std::atomic<int> tracking_waiting_{0};  // callers of lockForTracking not yet holding the lock
   std::set<KeyFramePtr, ById> keyframes_;
   std::set<MapPointPtr, ById> points_;
   KeyFramePtr origin_;
