@@ -59,6 +59,7 @@ Detection.async: 1
 Detection.maxAge: 0.375
 Detection.asyncThreads: 2
 Detection.asyncMinInterval: 0.05
+Detection.threadNice: 2
 Screening.mode: "detect"
 Screening.variant: "grow"
 Screening.varianceThreshold: 0.03125
