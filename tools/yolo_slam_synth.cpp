@@ -27,7 +27,7 @@ static void usage() {
       "Writes a TUM-format RGB-D sequence (rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt,\n"
       "associations.txt, camera.yaml) with dynamic ground truth (masks/, boxes.txt).\n"
       "Presets: walking_xyz (default) walking_static walking_rpy walking_half sitting_static\n"
-      "static_xyz loop crowd moved_object. --frames 0 keeps the preset's length. Same --seed,\n"
+      "static_xyz loop crowd close moved_object. --frames 0 keeps the preset's length. Same --seed,\n"
       "same bytes. --people-detail 0 drops the clothing pattern on people (default 0.6; 0: the\n"
       "sequences of before it); --no-objects leaves out the boxes (compare moved_object's ATE).\n");
 }

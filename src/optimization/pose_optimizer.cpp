@@ -73,6 +73,34 @@ class StackedPoseCost final : public ceres::CostFunction {
   const bool* robust_;
 };
 
+// The prior's 6 residuals: rotation vector of R R_p^T and R (c_p - c) = t - R R_p^T t_p, each
+// over its sigma. Under the left update (se3.h) the first moves with d phi as the identity
+// (exact at zero deviation), the second as Exp(phi) e + rho.
+class PosePriorCost final : public ceres::SizedCostFunction<6, kPoseParams> {
+ public:
+  explicit PosePriorCost(const PosePrior& p) : prior_(p) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const Pose T = paramsToPose(parameters[0]);
+    const Eigen::Matrix3d dR = T.linear() * prior_.T_cw.linear().transpose();
+    const Eigen::Vector3d e_rot = logSO3(dR);
+    const Eigen::Vector3d e_t = T.translation() - dR * prior_.T_cw.translation();
+    const double wr = 1.0 / prior_.sigma_rad, wt = 1.0 / prior_.sigma_m;
+    Eigen::Map<Eigen::Matrix<double, 6, 1>> r(residuals);
+    r << wr * e_rot, wt * e_t;
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 6, kPoseParams, Eigen::RowMajor>> J(jacobians[0]);
+      J.setZero();
+      J.block<3, 3>(0, 0) = wr * Eigen::Matrix3d::Identity();
+      J.block<3, 3>(3, 0) = -wt * skew(e_t);
+      J.block<3, 3>(3, 3) = wt * Eigen::Matrix3d::Identity();
+    }
+    return true;
+  }
+
+ private:
+  PosePrior prior_;
+};
+
 bool usable(const PoseObservation& o) {
   return o.Xw.allFinite() && o.uv.allFinite() && std::isfinite(o.u_right) &&
          std::isfinite(o.inv_sigma2) && o.inv_sigma2 > 0;
@@ -109,7 +137,7 @@ int classify(const Intrinsics& K, const double* pose, const std::vector<PoseObse
 }  // namespace
 
 int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObservation>& obs,
-                 std::vector<bool>& is_outlier, int rounds) {
+                 std::vector<bool>& is_outlier, int rounds, const PosePrior* prior) {
   const size_t n = obs.size();
   is_outlier.assign(n, false);
   int n_usable = 0;
@@ -138,6 +166,11 @@ int optimizePose(const CameraModel& cam, Pose& T_cw, const std::vector<PoseObser
   ceres::Problem problem(popts);
   problem.AddParameterBlock(pose, kPoseParams, &manifold);
   problem.AddResidualBlock(&cost, nullptr, pose);
+  std::unique_ptr<PosePriorCost> prior_cost;
+  if (prior && prior->T_cw.matrix().allFinite() && prior->sigma_m > 0 && prior->sigma_rad > 0) {
+    prior_cost = std::make_unique<PosePriorCost>(*prior);
+    problem.AddResidualBlock(prior_cost.get(), nullptr, pose);
+  }
 
   const ceres::Solver::Options sopts = solverOptions(ceres::DENSE_NORMAL_CHOLESKY, kIterationsPerRound);
   int n_bad = 0;

@@ -216,6 +216,12 @@ const std::vector<FloorSegment> kCrowdPaths = {{-2.2, 1.2, 2.2, 2.8},  {2.2, 1.3
                                                {-1.7, 1.2, 1.7, 1.2},  {-0.6, 1.3, 0.5, 2.9},
                                                {-1.9, 1.0, -1.3, 2.9}, {1.5, 0.9, 1.2, 2.9},
                                                {-2.4, 2.5, 2.4, 2.0}};
+// close: people near the camera, as hidden real sequences have them. One crosses 0.8 to
+// 0.9 m in front of the camera's start (a full-height person there covers most of the image,
+// cut by its top and bottom borders), one walks straight at the camera from 2.9 m to 0.75 m
+// and back, one crosses mid-room behind them.
+const std::vector<FloorSegment> kClosePaths = {{-1.7, 0.8, 1.7, 0.9}, {0.2, 2.9, 0.05, 0.75},
+                                               {2.2, 2.4, -2.2, 2.1}};
 // moved_object: the walker stands, fetches the box standing on the floor 2.7 m ahead, carries
 // it 2.2 m to the right, puts it down and leaves behind the camera. The floor comes into view
 // only beyond about 2.1 m, so both resting places lie farther.
@@ -234,6 +240,7 @@ const std::vector<PresetInfo>& presets() {
       {"static_xyz", "xyz", "no people; camera translating along its axes", 900, 0, 0, false, {}},
       {"loop", "loop", "one walker; the camera circles the room and returns to its start", 1200, 1, 0, false, kLoopPath},
       {"crowd", "replay", "seven people crossing and occluding each other, one carrying a box; the real fr3_walking_xyz camera motion", 860, 7, 0, true, kCrowdPaths},
+      {"close", "replay", "three people, two of them close to the camera (one crossing 0.8 m in front of it, one walking up to 0.75 m); the real fr3_walking_xyz camera motion", 827, 3, 0, false, kClosePaths},
       {"moved_object", "xyz", "a person picks up a box standing on the floor, carries it and puts it down; camera translating along its axes", 600, 1, 0, true, {}, kMoveBoxWalk, kMoveBoxTimes},
   };
   return p;

@@ -29,6 +29,11 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.youngMapFrames", &O::young_map_frames, Range::atLeast(1)},
       {"Tracking.youngLostResetFrames", &O::young_lost_reset_frames, Range::atLeast(0)},
       {"Tracking.voPoints", &O::vo_points, Range::atLeast(0)},
+      {"Tracking.motionPrior", &O::motion_prior, Range::closed(0, 1e6)},
+      {"Tracking.motionPriorDeg", &O::motion_prior_deg, Range::closed(0.01, 180)},
+      {"Tracking.maxJump", &O::max_jump, Range::closed(0, 1e6)},
+      {"Tracking.maxJumpDeg", &O::max_jump_deg, Range::closed(0, 180)},
+      {"Tracking.maxJumpInliers", &O::max_jump_inliers, Range::atLeast(0)},
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
   };
   return table;

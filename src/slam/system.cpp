@@ -446,10 +446,11 @@ SystemStats System::stats() const {
   }
   LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
-  size_t relocs = 0;
+  size_t relocs = 0, jumps = 0;
   {
     std::lock_guard<std::mutex> tl(track_mutex_);
     relocs = tracker_->relocalizations();
+    jumps = tracker_->jumpsRefused();
   }
   const size_t loops = loop_closer_ ? loop_closer_->loopsClosed() : 0;
   const size_t gbas = loop_closer_ ? loop_closer_->globalBundleAdjustments() : 0;
@@ -465,6 +466,7 @@ SystemStats System::stats() const {
   s.lm_culling_ms = std::move(lm.culling);
   s.keyframes_culled = culled;
   s.relocalizations = relocs;
+  s.jumps_refused = jumps;
   s.loops_closed = loops;
   s.global_bas = gbas;
   return s;
@@ -498,6 +500,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"map_points", s.map_points},
               {"map_resets", s.resets},
               {"relocalizations", s.relocalizations},
+              {"jumps_refused", s.jumps_refused},
               {"loops_closed", s.loops_closed},
               {"global_bundle_adjustments", s.global_bas},
               {"awaiting_detection", s.awaiting_detection},

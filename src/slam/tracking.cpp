@@ -165,6 +165,9 @@ TrackResult Tracking::trackFirst(Frame& F) {
 
 bool Tracking::trackFrame(Frame& F) {
   bool ok = false;
+  const bool predicted = state_ == TrackingState::Ok && has_last_ && has_velocity_;
+  const Pose prediction = predicted ? Pose(velocity_ * last_.T_cw) : Pose::Identity();
+  if (predicted && opt_.motion_prior > 0) prior_ = motionPrior(F, prediction);
   if (state_ == TrackingState::Ok && has_last_) {
     if (has_velocity_) ok = trackMotionModel(F);
     if (!ok && ref_kf_ && !ref_kf_->bad)
@@ -173,7 +176,33 @@ bool Tracking::trackFrame(Frame& F) {
     ok = trackWhenLost(F);
   }
   if (ok) ok = trackLocalMap(F);
+  prior_.reset();
+  if (ok && predicted && implausibleJump(F.T_cw, prediction)) {
+    ++jumps_refused_;
+    ok = false;
+  }
   return ok && finitePose(F.T_cw);
+}
+
+optimization::PosePrior Tracking::motionPrior(const Frame& F, const Pose& prediction) const {
+  // The prediction is one velocity step ahead of the last frame: after dropped frames it lags
+  // by the missing steps, so the sigmas widen with the gap.
+  double steps = 1.0;
+  if (std::isfinite(F.stamp) && std::isfinite(last_.stamp) && cam_.fps > 0)
+    steps = std::max(1.0, (F.stamp - last_.stamp) * cam_.fps);
+  optimization::PosePrior p;
+  p.T_cw = prediction;
+  p.sigma_m = opt_.motion_prior * steps;
+  p.sigma_rad = opt_.motion_prior_deg * M_PI / 180.0 * steps;
+  return p;
+}
+
+bool Tracking::implausibleJump(const Pose& T_cw, const Pose& prediction) const {
+  if (opt_.max_jump <= 0 || inliers_ >= opt_.max_jump_inliers) return false;
+  const Pose delta = T_cw * prediction.inverse();
+  const double moved = (T_cw.inverse().translation() - prediction.inverse().translation()).norm();
+  const double turned_deg = Eigen::AngleAxisd(delta.rotation()).angle() * 180.0 / M_PI;
+  return moved > opt_.max_jump || turned_deg > opt_.max_jump_deg;
 }
 
 void Tracking::onTracked(Frame& F, TrackResult& res) {
@@ -323,7 +352,7 @@ int Tracking::optimizePose(Frame& F) {
   if (obs.size() < 3) return 0;
   std::vector<bool> is_outlier(obs.size(), false);
   Pose T = F.T_cw;
-  int inl = optimization::optimizePose(cam_, T, obs, is_outlier);
+  int inl = optimization::optimizePose(cam_, T, obs, is_outlier, optimization::kPoseRounds, prior_ ? &*prior_ : nullptr);
   if (!finitePose(T)) return 0;
   F.setPose(T);
   for (size_t k = 0; k < idx.size(); ++k) F.outlier[idx[k]] = is_outlier[k];

@@ -123,6 +123,11 @@ Tracking.lostResetMaxKeyFrames: 4
 Tracking.youngMapFrames: 45
 Tracking.youngLostResetFrames: 3
 Tracking.voPoints: 80
+Tracking.motionPrior: 0.03125
+Tracking.motionPriorDeg: 1.5
+Tracking.maxJump: 0.125
+Tracking.maxJumpDeg: 7.5
+Tracking.maxJumpInliers: 90
 Tracking.maxStampGap: 0.5
 LocalMapping.triangulationNeighbours: 12
 LocalMapping.fuseNeighbours: 8
@@ -274,6 +279,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap),
             std::make_tuple(120, 4, 80, 0.5));
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points), std::make_tuple(45, 3, 150));
+  EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
+            std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
                      p.thread_nice),

@@ -126,3 +126,82 @@ TEST(SlamTracking, KeyFramePointsSetsTheFarPointsOfANewKeyFrame) {
   std::printf("map points: keyFramePoints 100 -> %zu, 300 -> %zu\n", orb, more);
   EXPECT_GT(more, orb + orb / 4);
 }
+
+namespace {
+
+struct JumpRun {
+  size_t refused = 0;
+  slam::TrackingState jumped = slam::TrackingState::NotInitialized;
+  double jump_m = 0;     // true camera displacement from frame 39
+  double tracked_m = -1;  // tracked displacement, when the jumped frame was tracked
+};
+
+// static_xyz frames 0-39, then a later frame of the path whose camera lies more than kJump from
+// frame 39's, stamped one frame after frame 39: to the tracker the camera jumps within a frame.
+// Every pose is "weakly supported" (maxJumpInliers huge), so only the distance decides; the
+// motion prior (default) is on.
+JumpRun runWithJump(double max_jump) {
+  constexpr double kJump = 0.15;
+  constexpr size_t kBefore = 40;
+  sim::SynthOptions so;
+  so.preset = "static_xyz";
+  so.frames = 120;
+  so.seed = 7;
+  sim::SequenceGenerator gen(so);
+  slam::SystemOptions opt = slam::SystemOptions::load(Config());
+  opt.screening.mode = screening::DynamicMode::Off;
+  opt.sequential = true;
+  opt.slam.tracking.max_jump = max_jump;
+  opt.slam.tracking.max_jump_inliers = 1 << 20;
+  slam::System sys(gen.camera(), opt, nullptr);
+  JumpRun run;
+  Pose last_true = Pose::Identity(), last_tracked = Pose::Identity();
+  for (size_t i = 0; i < kBefore; ++i) {
+    sim::SynthFrame f = gen.frame(i);
+    const slam::TrackResult r = sys.trackRgbd(f.bgr, f.depth, f.rgb_stamp, {});
+    EXPECT_EQ(r.state, slam::TrackingState::Ok) << i;
+    last_true = f.T_wc;
+    last_tracked = r.T_wc;
+  }
+  const double next_stamp = gen.frame(kBefore).rgb_stamp;
+  for (size_t j = kBefore; j < gen.size(); ++j) {
+    sim::SynthFrame f = gen.frame(j);
+    run.jump_m = (f.T_wc.translation() - last_true.translation()).norm();
+    if (run.jump_m <= kJump) continue;
+    const slam::TrackResult r = sys.trackRgbd(f.bgr, f.depth, next_stamp, {});
+    run.jumped = r.state;
+    if (r.state == slam::TrackingState::Ok) run.tracked_m = (r.T_wc.translation() - last_tracked.translation()).norm();
+    break;
+  }
+  run.refused = sys.stats().jumps_refused;
+  return run;
+}
+
+}  // namespace
+
+// Off, the tracker follows the jump in full (the motion prior, sigma 2 cm, does not hold back a
+// pose that hundreds of points pin down); with Tracking.maxJump 0.1 m the pose is refused.
+TEST(SlamTracking, MaxJumpRefusesAPoseFarFromTheMotionModel) {
+  const JumpRun off = runWithJump(0.0);
+  const JumpRun on = runWithJump(0.1);
+  std::printf("camera jump %.3f m: maxJump 0 -> %s, tracked %.3f m; 0.1 -> %s (%zu refused)\n", on.jump_m,
+              slam::toString(off.jumped), off.tracked_m, slam::toString(on.jumped), on.refused);
+  EXPECT_EQ(off.jumped, slam::TrackingState::Ok);
+  EXPECT_NEAR(off.tracked_m, off.jump_m, 0.01);
+  EXPECT_EQ(off.refused, 0u);
+  EXPECT_NE(on.jumped, slam::TrackingState::Ok);
+  EXPECT_EQ(on.refused, 1u);
+}
+
+// A camera that moves as cameras do (translation, rotation about its axes) never trips the
+// check, even with every pose counted as weakly supported.
+TEST(SlamTracking, MaxJumpNeverRefusesACameraThatMoves) {
+  for (const char* path : {"", "rpy", "halfsphere"}) {
+    const EmptyRoomRun run = runEmptyRoom(5, path, [&](CameraModel&, slam::SystemOptions& opt) {
+      opt.slam.tracking.max_jump = 0.1;
+      opt.slam.tracking.max_jump_inliers = 1 << 20;
+    });
+    EXPECT_EQ(run.tracked, kRunFrames) << path;
+    EXPECT_EQ(run.stats.jumps_refused, 0u) << path;
+  }
+}

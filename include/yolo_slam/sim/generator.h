@@ -104,8 +104,8 @@ struct PresetInfo {
 };
 // Analogues of TUM's fr3 walking and sitting sequences, static_xyz (no people), loop, crowd
 // (seven walkers crossing and occluding each other, one carrying a box, the real
-// fr3_walking_xyz motion) and moved_object (a box picked up from the floor, carried and put
-// down again: static, dynamic, static).
+// fr3_walking_xyz motion), close (people within a metre of the camera) and moved_object (a box
+// picked up from the floor, carried and put down again: static, dynamic, static).
 const std::vector<PresetInfo>& presets();
 
 class SequenceGenerator {

@@ -37,6 +37,20 @@ struct TrackingOptions {
   int young_map_frames = 30;        // Tracking.youngMapFrames
   int young_lost_reset_frames = 5;  // Tracking.youngLostResetFrames
   int vo_points = 100;              // Tracking.voPoints: temporary close points in the last frame
+  // Motion prior (beyond ORB-SLAM2): a frame tracked with the motion model is optimised with a
+  // Gaussian prior at the constant-velocity prediction, sigma motionPrior metres for the camera
+  // centre and motionPriorDeg degrees, times the frames since the last one. Strong static
+  // support outweighs it; it holds the directions a sliver of far static scene (people filling
+  // the view) leaves unconstrained. 0 = off.
+  double motion_prior = 0.02;       // Tracking.motionPrior (m)
+  double motion_prior_deg = 1.0;    // Tracking.motionPriorDeg
+  // maxJump > 0: a pose that lands more than maxJump metres (or maxJumpDeg degrees) from the
+  // constant-velocity prediction on fewer than maxJumpInliers inliers is refused (the frame
+  // fails), for a robot that would rather be lost than jump. Off by default: with the motion
+  // prior it changed nothing on the close preset and lost a frame in the crowd.
+  double max_jump = 0.0;            // Tracking.maxJump (m)
+  double max_jump_deg = 10.0;       // Tracking.maxJumpDeg
+  int max_jump_inliers = 100;       // Tracking.maxJumpInliers
   double max_stamp_gap = 1.0;       // Tracking.maxStampGap (s): a larger gap drops the motion model
 
   static TrackingOptions load(const Config& cfg);

@@ -4,12 +4,14 @@
 // fallback, local-map tracking, pose-only optimisation and the keyframe decision.
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/optimization/pose_optimizer.h"
 #include "yolo_slam/slam/frame.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
 #include "yolo_slam/slam/types.h"
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace yolo_slam {
@@ -63,6 +65,8 @@ class Tracking {
   size_t lostFrames() const { return lost_; }
   size_t resets() const { return resets_; }
   size_t relocalizations() const { return relocalizations_; }
+  // Frames whose pose was refused as a jump from the motion model (Tracking.maxJump).
+  size_t jumpsRefused() const { return jumps_refused_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -73,6 +77,12 @@ class Tracking {
   TrackResult trackFirst(Frame& F);   // not initialised yet: initialise on F
   // Motion model, reference keyframe or (lost) relocalisation, then the local map.
   bool trackFrame(Frame& F);
+  // T_cw (tracked on inliers_) lies farther from the constant-velocity prediction than a camera
+  // moves in a frame, on too few inliers to trust it (TrackingOptions::max_jump).
+  bool implausibleJump(const Pose& T_cw, const Pose& prediction) const;
+  // The motion prior for F (TrackingOptions::motion_prior), sigmas scaled by the frames since the
+  // last frame.
+  optimization::PosePrior motionPrior(const Frame& F, const Pose& prediction) const;
   void onTracked(Frame& F, TrackResult& res);
   void onFailed(TrackResult& res);
   // Reset rules of a lost map: lost for lost_reset_frames with at most lost_reset_max_keyframes
@@ -153,7 +163,10 @@ class Tracking {
   std::vector<FrameRecord> records_;
   Trajectory frozen_keyframes_;
   long last_reloc_frame_id_ = -1;
-  size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0;
+  // Set by trackFrame while it tracks a frame the motion model predicts; every pose
+  // optimisation of that frame uses it.
+  std::optional<optimization::PosePrior> prior_;
+  size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
 };
 
 }  // namespace slam
