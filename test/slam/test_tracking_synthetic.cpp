@@ -50,6 +50,24 @@ namespace {
 
 constexpr int kRunFrames = 60;
 
+// The empty room (static_xyz, no people) along a camera path ("" = the preset's).
+sim::SynthOptions emptyRoom(unsigned seed, const std::string& trajectory, int frames) {
+  sim::SynthOptions so;
+  so.preset = "static_xyz";
+  so.trajectory = trajectory;
+  so.frames = frames;
+  so.seed = seed;
+  return so;
+}
+
+// The defaults in sequential mode (results independent of thread timing), screening off.
+slam::SystemOptions sequentialNoScreening() {
+  slam::SystemOptions opt = slam::SystemOptions::load(Config());
+  opt.screening.mode = screening::DynamicMode::Off;
+  opt.sequential = true;
+  return opt;
+}
+
 struct EmptyRoomRun {
   int tracked = 0;
   slam::SystemStats stats;
@@ -59,16 +77,9 @@ struct EmptyRoomRun {
 // the caller's changes to the camera and the options.
 template <typename Tweak>
 EmptyRoomRun runEmptyRoom(unsigned seed, const std::string& trajectory, Tweak tweak) {
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.trajectory = trajectory;
-  so.frames = kRunFrames;
-  so.seed = seed;
-  sim::SequenceGenerator gen(so);
+  sim::SequenceGenerator gen(emptyRoom(seed, trajectory, kRunFrames));
   CameraModel cam = gen.camera();
-  slam::SystemOptions opt = slam::SystemOptions::load(Config());
-  opt.screening.mode = screening::DynamicMode::Off;
-  opt.sequential = true;
+  slam::SystemOptions opt = sequentialNoScreening();
   tweak(cam, opt);
   slam::System sys(cam, opt, nullptr);
   EmptyRoomRun run;
@@ -143,14 +154,8 @@ struct JumpRun {
 JumpRun runWithJump(double max_jump) {
   constexpr double kJump = 0.15;
   constexpr size_t kBefore = 40;
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.frames = 120;
-  so.seed = 7;
-  sim::SequenceGenerator gen(so);
-  slam::SystemOptions opt = slam::SystemOptions::load(Config());
-  opt.screening.mode = screening::DynamicMode::Off;
-  opt.sequential = true;
+  sim::SequenceGenerator gen(emptyRoom(7, "", 120));
+  slam::SystemOptions opt = sequentialNoScreening();
   opt.slam.tracking.max_jump = max_jump;
   opt.slam.tracking.max_jump_inliers = 1 << 20;
   slam::System sys(gen.camera(), opt, nullptr);
