@@ -7,7 +7,9 @@
 // Only Screener::screen is replayed: the static-box veto, motion screening and the adaptive
 // feature budget of the run are not (set ORBextractor.nFeatures to the run's mean budget to
 // come closer). Also prints how far the wrongly dropped static keypoints lie from the nearest
-// person pixel (ground-truth mask): a keypoint a few pixels off a person straddles its outline.
+// person pixel (ground-truth mask): a keypoint a few pixels off a person straddles its outline;
+// and where the person keypoints left static are (outside the boxes, without depth, or at
+// which depth against what their box dropped: another person standing behind the boxed one).
 #include "yolo_slam/common/camera.h"
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
@@ -19,6 +21,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -112,6 +115,62 @@ void count(const features::FeatureFrame& f, const cv::Mat& mask, const detection
   }
 }
 
+// Person keypoints a configuration leaves static, by where they are and, in a box with depth,
+// how their depth compares with the median depth of the keypoints the box dropped: a person
+// more than kBehindM behind that is mostly another person, standing behind the boxed one.
+constexpr double kBehindM = 0.5;
+
+struct Misses {
+  long outside_depth = 0, outside_hole = 0, in_box_hole = 0, box_dropped_nothing = 0;
+  long nearer = 0, within = 0, behind = 0, far_behind = 0;
+};
+
+// Median depth of the keypoints with depth dropped inside r (0 if none).
+float droppedDepth(const features::FeatureFrame& f, const cv::Rect2f& r) {
+  std::vector<float> d;
+  for (size_t i = 0; i < f.keypoints.size(); ++i)
+    if (f.dynamic[i] && f.depth[i] > 0 && inside(r, f.keypoints[i].pt)) d.push_back(f.depth[i]);
+  if (d.empty()) return 0.f;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+// In a box with depth, the keypoint is compared with the box (of those containing it) whose
+// dropped median depth is nearest to its own.
+void countMisses(const features::FeatureFrame& f, const cv::Mat& mask, const detection::Boxes& boxes,
+                 const ScreeningOptions& o, Misses& m) {
+  std::vector<cv::Rect2f> rects;
+  std::vector<float> dropped_at;
+  for (const auto& b : boxes) {
+    rects.push_back(dilate(b.rect, o.box_dilation));
+    dropped_at.push_back(droppedDepth(f, rects.back()));
+  }
+  for (size_t i = 0; i < f.keypoints.size(); ++i) {
+    const cv::Point2f p = f.keypoints[i].pt;
+    const int x = std::min(mask.cols - 1, std::max(0, static_cast<int>(std::lround(p.x))));
+    const int y = std::min(mask.rows - 1, std::max(0, static_cast<int>(std::lround(p.y))));
+    if (mask.at<uint8_t>(y, x) != 255 || f.dynamic[i]) continue;
+    const float d = f.depth[i];
+    int box = -1;
+    for (size_t b = 0; b < rects.size(); ++b)
+      if (inside(rects[b], p) &&
+          (box < 0 || std::abs(dropped_at[b] - d) < std::abs(dropped_at[box] - d)))
+        box = static_cast<int>(b);
+    if (box < 0) {
+      ++(d > 0 ? m.outside_depth : m.outside_hole);
+    } else if (d <= 0) {
+      ++m.in_box_hole;
+    } else if (dropped_at[box] <= 0) {
+      ++m.box_dropped_nothing;
+    } else {
+      const double gap = d - dropped_at[box];
+      if (gap < -o.grow_depth_m) ++m.nearer;
+      else if (gap <= o.grow_depth_m) ++m.within;
+      else ++(gap <= kBehindM ? m.behind : m.far_behind);
+    }
+  }
+}
+
 // Distance buckets (pixels to the nearest dynamic mask pixel) of the static keypoints dropped.
 const std::vector<double> kBuckets = {2, 5, 10, 20, 40, 1e9};
 
@@ -143,6 +202,7 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
   const std::vector<Variant> vs = variants();
   std::vector<Split> split(vs.size());
   std::vector<long> hist(kBuckets.size(), 0), hist_hole(kBuckets.size(), 0);
+  Misses misses;
   std::ifstream assoc(joinPath(dir, "associations.txt"));
   if (!assoc) throw Error(joinPath(dir, "associations.txt") + ": not found");
   std::string line;
@@ -169,7 +229,10 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
       features::FeatureFrame f = frame;
       Screener(o).screen(f, boxes, depth_m);
       count(f, mask, boxes, o.box_dilation, split[k]);
-      if (k == 0) distances(f, mask, hist, hist_hole);
+      if (k == 0) {
+        distances(f, mask, hist, hist_hole);
+        countMisses(f, mask, boxes, o, misses);
+      }
     }
     ++used;
   }
@@ -188,6 +251,14 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
   for (size_t k = 0; k < kBuckets.size(); ++k)
     std::printf("| %s | %ld | %ld |\n", kBuckets[k] > 1e8 ? "more" : std::to_string(int(kBuckets[k])).c_str(),
                 hist[k], hist_hole[k]);
+  std::printf("\nperson keypoints the configuration leaves static (in a box with depth: against "
+              "the median depth the box dropped, +- growDepth):\n"
+              "| outside every box, depth | outside, no depth | in a box, no depth | box dropped "
+              "nothing | nearer | within | behind, up to %.1f m | more than %.1f m behind |\n"
+              "|---|---|---|---|---|---|---|---|\n| %ld | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n",
+              kBehindM, kBehindM, misses.outside_depth, misses.outside_hole, misses.in_box_hole,
+              misses.box_dropped_nothing, misses.nearer, misses.within, misses.behind,
+              misses.far_behind);
 }
 
 }  // namespace

@@ -111,6 +111,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Screening.growDepth",
       "Screening.growOutside",
       "Screening.growRadius",
+      "Screening.maskInBoxes",
       "Screening.maxIterations",
       "Screening.mode",
       "Screening.motionFlowTolerance",

@@ -1,4 +1,5 @@
 #include "yolo_slam/screening/person_mask.h"
+#include "yolo_slam/screening/screener.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -95,6 +96,24 @@ int markGrownOutside(const features::FeatureFrame& frame, const cv::Mat& mask,
   for (size_t i = 0; i < frame.keypoints.size(); ++i) {
     if (in_any[i] || drop[i] || frame.depth[i] <= 0) continue;
     if (!personCellAt(mask, frame.keypoints[i].pt)) continue;
+    drop[i] = 1;
+    ++marked;
+  }
+  return marked;
+}
+
+int markGrownInBoxes(const features::FeatureFrame& frame, const cv::Mat& mask,
+                     const std::vector<BoxPerson>& boxes, const std::vector<uint8_t>& in_any,
+                     std::vector<uint8_t>& drop) {
+  int marked = 0;
+  for (size_t i = 0; i < frame.keypoints.size(); ++i) {
+    const float d = frame.depth[i];
+    const cv::Point2f p = frame.keypoints[i].pt;
+    if (!in_any[i] || drop[i] || d <= 0 || !personCellAt(mask, p)) continue;
+    bool anothers = true;
+    for (const BoxPerson& b : boxes)
+      if (inside(b.region, p) && (b.keeps_all || (d >= b.lo && d <= b.hi))) anothers = false;
+    if (!anothers) continue;
     drop[i] = 1;
     ++marked;
   }

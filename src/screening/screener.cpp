@@ -62,6 +62,7 @@ const OptionTable<ScreeningOptions>& screeningFields() {
       {"Screening.flatBoxTolerance", &O::flat_box_tolerance, Range::positive()},
       {"Screening.flatBoxRing", &O::flat_box_ring, Range::openClosed(0, 2)},
       {"Screening.growOutside", &O::grow_outside, Range::closed(0, 1)},
+      {"Screening.maskInBoxes", &O::mask_in_boxes},
       {"Screening.noDepthHoleRadius", &O::no_depth_hole_radius_px, Range::atLeast(0)},
       {"Screening.noDepthProbeRadius", &O::no_depth_probe_radius_px, Range::atLeast(0)},
   };
@@ -477,6 +478,20 @@ cv::Mat personDistanceOf(const ScreeningOptions& o, const std::vector<Region>& r
   return personDistance(mask);
 }
 
+// Every box for the in-box rule: its region and its person's depth range (personSeeds's).
+std::vector<BoxPerson> boxPeople(const ScreeningOptions& o, const std::vector<Region>& regions,
+                                 const std::vector<uint8_t>& flat, const detection::Boxes& boxes) {
+  std::vector<BoxPerson> out(regions.size());
+  for (size_t b = 0; b < regions.size(); ++b) {
+    const PersonSeeds p = personSeeds(o, regions[b], boxes[b].rect);
+    out[b].region = *regions[b].box;
+    out[b].lo = p.lo;
+    out[b].hi = p.hi;
+    out[b].keeps_all = flat[b] || p.pts.empty();
+  }
+  return out;
+}
+
 // The keypoints of a region's person set.
 std::vector<int> personSet(const Region& r) {
   std::vector<int> out;
@@ -549,6 +564,8 @@ void markBoxes(const Screener& s, const features::FeatureFrame& frame, const det
   for (size_t b = 0; b < regions.size(); ++b)
     if (!flat[b]) markRegion(o, frame, regions[b], person, drop, st);
   if (person.distance.empty()) return;
+  if (o.mask_in_boxes)
+    st.grown_in_boxes += markGrownInBoxes(frame, person.mask, boxPeople(o, regions, flat, boxes), in_any, drop);
   st.grown_outside += markGrownOutside(frame, person.mask, in_any, drop);
   st.depth_holes += markHolesOutside(frame, person.distance, o.no_depth_hole_radius_px, in_any, drop);
 }
@@ -694,6 +711,7 @@ ScreeningStats& ScreeningStats::operator+=(const ScreeningStats& o) {
   silhouette += o.silhouette;
   occluded_boxes += o.occluded_boxes;
   grown_outside += o.grown_outside;
+  grown_in_boxes += o.grown_in_boxes;
   depth_holes += o.depth_holes;
   return *this;
 }
@@ -702,7 +720,8 @@ void to_json(Json& j, const ScreeningStats& s) {
   j = Json{{"in_boxes", s.in_boxes},     {"kept", s.kept},
            {"dropped", s.dropped},       {"silhouette", s.silhouette},
            {"flat_boxes", s.flat_boxes}, {"occluded_boxes", s.occluded_boxes},
-           {"grown_outside", s.grown_outside}, {"depth_holes", s.depth_holes},
+           {"grown_outside", s.grown_outside}, {"grown_in_boxes", s.grown_in_boxes},
+           {"depth_holes", s.depth_holes},
            {"iterations", s.iterations}};
 }
 

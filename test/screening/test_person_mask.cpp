@@ -1,6 +1,6 @@
-// Screening beyond the boxes: the grown person mask, the keypoints outside every box it drops
-// and the no-depth keypoints it keeps or drops (person_mask.h, Screening.growOutside,
-// Screening.noDepthHoleRadius).
+// Screening beyond the boxes: the grown person mask, the keypoints outside every box and those
+// of a person behind a boxed one it drops, and the no-depth keypoints it keeps or drops
+// (person_mask.h, Screening.growOutside, Screening.maskInBoxes, Screening.noDepthHoleRadius).
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/screening/person_mask.h"
@@ -154,10 +154,72 @@ TEST(BeyondBoxes, OffWithoutGrowthOrDepthImage) {
   EXPECT_EQ(s2.frame.dynamic[p.box_hole], 1);  // no depth image: the near-dynamic rule as before
 }
 
+namespace {
+
+constexpr float kBehind = 2.5f;
+
+// The wall at 4 m; a person at 1.5 m over x 150-239, boxed at x 100-249; a second person at
+// 2.5 m over x 240-329 standing behind the first, whose own box (x 262-331) misses their left
+// edge, x 240-258, which lies in the first person's dilated box (up to x 257.5).
+struct TwoPeople {
+  Scene scene;
+  cv::Mat depth = cv::Mat(480, 640, CV_32F, cv::Scalar(kWall));
+  int behind_in_front_box = 0, behind_in_front_box2 = 0, wall_in_front_box = 0;
+  TwoPeople() {
+    depth(cv::Rect(240, 60, 90, 400)).setTo(kBehind);
+    depth(cv::Rect(150, 50, 90, 420)).setTo(kPerson);
+    Scene& s = scene;
+    s.frame.width = 640;
+    s.frame.height = 480;
+    for (int x = 155; x <= 235; x += 20)
+      for (int y = 80; y <= 440; y += 40) s.add(cv::Point2f(x, y), kPerson);
+    for (int x = 270; x <= 325; x += 15)
+      for (int y = 80; y <= 440; y += 40) s.add(cv::Point2f(x, y), kBehind);
+    behind_in_front_box = s.add({246, 200}, kBehind);
+    behind_in_front_box2 = s.add({252, 320}, kBehind);
+    wall_in_front_box = s.add({115, 200}, kWall);
+    s.frame.keypoints_un = s.frame.keypoints;
+    s.boxes.resize(2);
+    s.boxes[0].rect = cv::Rect2f(100, 50, 150, 420);
+    s.boxes[1].rect = cv::Rect2f(262, 60, 70, 400);
+    for (auto& b : s.boxes) {
+      b.label = "person";
+      b.score = 0.9f;
+    }
+  }
+};
+
+}  // namespace
+
+// A person standing behind the boxed one, beyond their own box: the front box's screening
+// keeps them (its person is the front one), the mask grown from their own box reaches them.
+TEST(BeyondBoxes, DropsAPersonBehindTheBoxedOneBeyondTheirOwnBox) {
+  TwoPeople on;
+  ScreeningOptions o;
+  ASSERT_FALSE(o.mask_in_boxes);  // off by default
+  o.mask_in_boxes = true;
+  const ScreeningStats st = Screener(o).screen(on.scene.frame, on.scene.boxes, on.depth);
+  EXPECT_EQ(on.scene.frame.dynamic[on.behind_in_front_box], 1);
+  EXPECT_EQ(on.scene.frame.dynamic[on.behind_in_front_box2], 1);
+  EXPECT_EQ(on.scene.frame.dynamic[on.wall_in_front_box], 0);
+  EXPECT_EQ(st.grown_in_boxes, 2);
+  EXPECT_EQ(Json(st).at("grown_in_boxes"), 2);
+
+  const ScreeningOptions off;
+  TwoPeople without;
+  const ScreeningStats st_off = Screener(off).screen(without.scene.frame, without.scene.boxes, without.depth);
+  EXPECT_EQ(without.scene.frame.dynamic[without.behind_in_front_box], 0);
+  EXPECT_EQ(without.scene.frame.dynamic[without.behind_in_front_box2], 0);
+  EXPECT_EQ(st_off.grown_in_boxes, 0);
+  EXPECT_EQ(st.dropped, st_off.dropped + 2);
+}
+
 TEST(BeyondBoxes, OptionsLoadAndValidate) {
   const ScreeningOptions o = ScreeningOptions::load(
-      Config::fromString("Screening.growOutside: 0.5\nScreening.noDepthHoleRadius: 8\n", "s.yaml"));
+      Config::fromString("Screening.growOutside: 0.5\nScreening.noDepthHoleRadius: 8\n"
+                         "Screening.maskInBoxes: 1\n", "s.yaml"));
   EXPECT_EQ(o.grow_outside, 0.5);
+  EXPECT_TRUE(o.mask_in_boxes);
   EXPECT_EQ(o.no_depth_hole_radius_px, 8.0);
   EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.growOutside: -0.1\n", "s.yaml")), Error);
   EXPECT_THROW(ScreeningOptions::load(Config::fromString("Screening.growOutside: 1.5\n", "s.yaml")), Error);

@@ -81,6 +81,7 @@ Screening.flatBoxRing: 0.375
 Screening.occlusionRule: 0
 Screening.occlusionMaxIou: 0.375
 Screening.growOutside: 0.375
+Screening.maskInBoxes: 1
 Screening.noDepthHoleRadius: 12.5
 Screening.noDepthProbeRadius: 6.5
 Screening.trackBoxes: 0
@@ -254,6 +255,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(s.occlusion_rule, s.occlusion_max_iou), std::make_tuple(false, 0.375));
   EXPECT_EQ(std::tie(s.grow_outside, s.no_depth_hole_radius_px, s.no_depth_probe_radius_px),
             std::make_tuple(0.375, 12.5, 6.5));
+  EXPECT_TRUE(s.mask_in_boxes);
   EXPECT_EQ(std::tie(s.reject_flat_boxes, s.flat_box_fraction, s.flat_box_tolerance, s.flat_box_ring),
             std::make_tuple(true, 0.5, 0.015625, 0.375));
   const screening::BoxTrackerOptions& t = s.tracker;

@@ -13,18 +13,34 @@
 
 using namespace yolo_slam;
 
-TEST(SlamTracking, SyntheticStaticXyzAteBound) {
+namespace {
+
+constexpr int kRunFrames = 60;
+
+// The empty room (static_xyz, no people) along a camera path ("" = the preset's).
+sim::SynthOptions emptyRoom(unsigned seed, const std::string& trajectory, int frames) {
   sim::SynthOptions so;
   so.preset = "static_xyz";
-  so.frames = 80;
-  so.seed = 3;
-  sim::SequenceGenerator gen(so);
-  ASSERT_EQ(gen.size(), 80u);
+  so.trajectory = trajectory;
+  so.frames = frames;
+  so.seed = seed;
+  return so;
+}
 
+// The defaults in sequential mode (results independent of thread timing), screening off.
+slam::SystemOptions sequentialNoScreening() {
   slam::SystemOptions opt = slam::SystemOptions::load(Config());
   opt.screening.mode = screening::DynamicMode::Off;
-  opt.sequential = true;  // no thread timing: the same result on every run
-  slam::System sys(gen.camera(), opt, nullptr);
+  opt.sequential = true;
+  return opt;
+}
+
+}  // namespace
+
+TEST(SlamTracking, SyntheticStaticXyzAteBound) {
+  sim::SequenceGenerator gen(emptyRoom(3, "", 80));
+  ASSERT_EQ(gen.size(), 80u);
+  slam::System sys(gen.camera(), sequentialNoScreening(), nullptr);
   Trajectory gt;
   int tracked = 0;
   for (size_t i = 0; i < gen.size(); ++i) {
@@ -47,26 +63,6 @@ TEST(SlamTracking, SyntheticStaticXyzAteBound) {
 }
 
 namespace {
-
-constexpr int kRunFrames = 60;
-
-// The empty room (static_xyz, no people) along a camera path ("" = the preset's).
-sim::SynthOptions emptyRoom(unsigned seed, const std::string& trajectory, int frames) {
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.trajectory = trajectory;
-  so.frames = frames;
-  so.seed = seed;
-  return so;
-}
-
-// The defaults in sequential mode (results independent of thread timing), screening off.
-slam::SystemOptions sequentialNoScreening() {
-  slam::SystemOptions opt = slam::SystemOptions::load(Config());
-  opt.screening.mode = screening::DynamicMode::Off;
-  opt.sequential = true;
-  return opt;
-}
 
 struct EmptyRoomRun {
   int tracked = 0;

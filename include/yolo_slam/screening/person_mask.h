@@ -1,8 +1,10 @@
 #pragma once
 // Screening beyond the boxes: the pixels of each person found in a box, grown by
 // depth continuity from the person's keypoints over the depth image, a little past the box.
-// Two rules read the mask: keypoints with depth outside every box that lie on it are the
-// person's (a detector box cuts off an arm, a head or a carried object), and keypoints without
+// Three rules read the mask: keypoints with depth outside every box that lie on it are the
+// person's (a detector box cuts off an arm, a head or a carried object); keypoints with depth
+// inside a box that lie on it at a depth off that box's person are another person's, standing
+// behind the boxed one beyond their own box (Screening.maskInBoxes); and keypoints without
 // depth near it sit in the depth holes of the person's outline and hair (Screening.growOutside,
 // Screening.noDepthHoleRadius).
 #include "yolo_slam/features/feature_frame.h"
@@ -50,6 +52,21 @@ constexpr float kPersonMaskStepPerM = 0.03f;
 // marked in drop. Returns how many.
 int markGrownOutside(const features::FeatureFrame& frame, const cv::Mat& mask,
                      const std::vector<uint8_t>& in_any, std::vector<uint8_t>& drop);
+
+// A box as the in-box rule sees it: its screened region and the depth range of the person its
+// screening found ([lo, hi]); keeps_all for a box without a person or left alone as flat.
+struct BoxPerson {
+  cv::Rect2f region;
+  float lo = 0.f, hi = 0.f;
+  bool keeps_all = false;
+};
+
+// Keypoints inside a box (in_any 1), not dropped, with depth, on the person mask, whose depth
+// lies outside the person range of every box holding them are marked in drop (no box that
+// holds them keeps all). Returns how many.
+int markGrownInBoxes(const features::FeatureFrame& frame, const cv::Mat& mask,
+                     const std::vector<BoxPerson>& boxes, const std::vector<uint8_t>& in_any,
+                     std::vector<uint8_t>& drop);
 
 // Keypoints outside every box without depth within radius_px of a person pixel are marked in
 // drop. Returns how many.
