@@ -91,7 +91,8 @@ const std::map<std::string, std::string> kPythonKey = {
     {"diagnostic_msgs", "diagnostic_msgs"}, {"nav_msgs", "nav_msgs"}, {"tf2_ros", "tf2_ros"}};
 const std::set<std::string> kPythonStdlib = {"argparse", "collections", "json", "math", "os", "re",
                                              "statistics", "sys", "xml", "subprocess", "time", "glob",
-                                             "shutil", "struct", "tempfile", "itertools", "functools", "signal"};
+                                             "shutil", "struct", "tempfile", "itertools", "functools", "signal",
+                                             "random"};
 // Keys a build needs without an include of their own.
 const std::set<std::string> kBuildOnlyKeys = {"catkin", "message_generation", "message_runtime"};
 
