@@ -146,6 +146,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Screening.trackMaxHamming",
       "Screening.trackMinMatches",
       "Screening.trackMinScore",
+      "Screening.trackShiftStale",
       "Screening.trackRadius",
       "Screening.varianceThreshold",
       "Screening.variant",

@@ -6,6 +6,7 @@
 #include "yolo_slam/common/timing.h"
 #include "yolo_slam/common/thread_name.h"
 
+#include <algorithm>
 
 namespace yolo_slam {
 namespace detection {
@@ -114,6 +115,7 @@ FrameBoxes BoxFeed::take(const std::optional<DetectionResult>& newest, double fr
   }
   fb.fresh = true;
   fb.boxes = newest->boxes;
+  for (Box& b : fb.boxes) b.age_s = std::max(0.0, fb.age_s);
   return fb;
 }
 

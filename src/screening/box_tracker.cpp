@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <tuple>
 
 namespace yolo_slam {
@@ -28,6 +29,7 @@ const OptionTable<BoxTrackerOptions>& trackerFields() {
       {"Screening.trackMaxHamming", &O::max_hamming, Range::closed(0, 256)},
       {"Screening.trackMinMatches", &O::min_matches, Range::atLeast(1)},
       {"Screening.trackMinScore", &O::min_score, Range::closed(0, 1)},
+      {"Screening.trackShiftStale", &O::shift_stale},
   };
   return table;
 }
@@ -75,20 +77,20 @@ bool BoxTracker::displacement(const Track& t, const features::FeatureFrame& fram
   return true;
 }
 
-detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
-                                     const detection::Boxes& detections, bool detector_ran) {
-  detection::Boxes out = detections;
-  for (auto& b : out) b.tracked = false;
-  const size_t nd = detections.size();
-  std::vector<int> det_track(nd, -1);     // track index associated to each detection
-  std::vector<int> track_det(tracks_.size(), -1);
+namespace {
 
+// Two stamps closer than this are the same frame.
+constexpr double kSameStampS = 1e-4;
+
+}  // namespace
+
+std::vector<int> BoxTracker::associate(const detection::Boxes& detections) const {
   // Greedy one-to-one association by decreasing IoU with the track's last box (ties: lower
   // track id, then lower detection index), so the result does not depend on container order
   // beyond ids.
   std::vector<std::tuple<double, size_t, size_t>> pairs;
   for (size_t t = 0; t < tracks_.size(); ++t)
-    for (size_t j = 0; j < nd; ++j) {
+    for (size_t j = 0; j < detections.size(); ++j) {
       const double v = iou(tracks_[t].box.rect, detections[j].rect);
       if (v >= opt_.iou_associate) pairs.emplace_back(v, t, j);
     }
@@ -97,54 +99,112 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
     if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
     return std::get<2>(a) < std::get<2>(b);
   });
+  std::vector<int> track_det(tracks_.size(), -1), det_track(detections.size(), -1);
   for (const auto& p : pairs) {
     const size_t t = std::get<1>(p), j = std::get<2>(p);
     if (track_det[t] >= 0 || det_track[j] >= 0) continue;
     track_det[t] = static_cast<int>(j);
     det_track[j] = static_cast<int>(t);
   }
+  return track_det;
+}
 
+std::optional<cv::Point2f> BoxTracker::travelAt(const Track& t, double stamp) {
+  for (size_t k = 0; k < t.seen.size(); ++k) {
+    if (std::abs(t.seen[k].stamp - stamp) <= kSameStampS) return t.seen[k].travel;
+    // Between two frames the tracker saw (the stream dropped the detected one): interpolated.
+    if (k > 0 && t.seen[k - 1].stamp < stamp && stamp < t.seen[k].stamp) {
+      const float a = static_cast<float>((stamp - t.seen[k - 1].stamp) / (t.seen[k].stamp - t.seen[k - 1].stamp));
+      return t.seen[k - 1].travel + a * (t.seen[k].travel - t.seen[k - 1].travel);
+    }
+  }
+  return std::nullopt;
+}
+
+detection::Box BoxTracker::placeDetection(const Track& t, const features::FeatureFrame& frame,
+                                          const detection::Box& det) const {
+  if (!opt_.shift_stale || det.age_s <= 0 || !t.moved_now) return det;
+  const std::optional<cv::Point2f> then = travelAt(t, frame.stamp - det.age_s);
+  if (!then) return det;
+  const cv::Point2f shift = t.travel + *t.moved_now - *then;
+  detection::Box moved = det;
   const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
+  cv::Rect2f r(det.rect.x + shift.x, det.rect.y + shift.y, det.rect.width, det.rect.height);
+  if (frame.width > 0 && frame.height > 0) r &= image;
+  if (r.area() <= 0) return det;
+  moved.rect = r;
+  return moved;
+}
+
+bool BoxTracker::carry(Track& tr, const features::FeatureFrame& frame, const detection::Boxes& placed,
+                       bool detector_ran) const {
+  // A weak track is dropped when the detector looked and did not find it again; a frame the
+  // detector never saw (asynchronous detection) carries every track.
+  if (++tr.age > opt_.max_age || (detector_ran && tr.box.score < opt_.min_score)) return false;
+  if (!tr.moved_now) return false;
+  const cv::Point2f d = *tr.moved_now;
+  const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
+  cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);
+  const cv::Rect2f visible = frame.width > 0 && frame.height > 0 ? (moved & image) : moved;
+  // Mostly outside the image: the person walked out of view.
+  if (!(visible.area() >= 0.2f * moved.area()) || visible.area() <= 0) return false;
+  // A detection already screens this person (its box changed too much for the IoU test):
+  // no duplicate; the detection's own track carries on.
+  for (const auto& p : placed)
+    if ((visible & p.rect).area() >= opt_.covered_fraction * visible.area()) return false;
+  tr.box.rect = visible;
+  tr.box.tracked = true;
+  return true;
+}
+
+detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
+                                     const detection::Boxes& detections, bool detector_ran) {
+  const std::vector<int> track_det = associate(detections);
+  // How far each track's keypoints moved since the last frame: carries undetected tracks, and
+  // (shift_stale) measures the person's travel that a detection of an earlier image missed.
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    Track& tr = tracks_[t];
+    cv::Point2f d;
+    const bool needed = track_det[t] < 0 || opt_.shift_stale;
+    tr.moved_now = needed && displacement(tr, frame, d) ? std::optional<cv::Point2f>(d) : std::nullopt;
+  }
+  detection::Boxes out = detections;
+  for (size_t t = 0; t < tracks_.size(); ++t)
+    if (track_det[t] >= 0) out[track_det[t]] = placeDetection(tracks_[t], frame, detections[track_det[t]]);
+  for (auto& b : out) b.tracked = false;
+  const size_t nd = detections.size();
+  std::vector<bool> det_used(nd, false);
+
+  const detection::Boxes placed(out.begin(), out.end());  // the detections where screened
   std::vector<Track> kept;
   kept.reserve(tracks_.size() + nd);
   for (size_t t = 0; t < tracks_.size(); ++t) {
     Track& tr = tracks_[t];
     if (track_det[t] >= 0) {
-      tr.box = detections[track_det[t]];
-      tr.box.tracked = false;
+      det_used[track_det[t]] = true;
+      tr.box = out[track_det[t]];
       tr.age = 0;
       kept.push_back(std::move(tr));
-      continue;
+    } else if (carry(tr, frame, placed, detector_ran)) {
+      out.push_back(tr.box);
+      kept.push_back(std::move(tr));
     }
-    // A weak track is dropped when the detector looked and did not find it again; a frame the
-    // detector never saw (asynchronous detection) carries every track.
-    if (++tr.age > opt_.max_age || (detector_ran && tr.box.score < opt_.min_score)) continue;
-    cv::Point2f d;
-    if (!displacement(tr, frame, d)) continue;
-    cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);
-    const cv::Rect2f visible = frame.width > 0 && frame.height > 0 ? (moved & image) : moved;
-    // Mostly outside the image: the person walked out of view.
-    if (!(visible.area() >= 0.2f * moved.area()) || visible.area() <= 0) continue;
-    // A detection already screens this person (its box changed too much for the IoU test):
-    // no duplicate; the detection's own track carries on.
-    bool covered = false;
-    for (size_t j = 0; j < nd && !covered; ++j)
-      covered = (visible & detections[j].rect).area() >= opt_.covered_fraction * visible.area();
-    if (covered) continue;
-    tr.box.rect = visible;
-    tr.box.tracked = true;
-    out.push_back(tr.box);
-    kept.push_back(std::move(tr));
   }
   for (size_t j = 0; j < nd; ++j) {
-    if (det_track[j] >= 0) continue;
+    if (det_used[j]) continue;
     Track tr;
     tr.id = next_id_++;
-    tr.box = detections[j];
-    tr.box.tracked = false;
+    tr.box = out[j];
     kept.push_back(std::move(tr));
   }
   std::sort(kept.begin(), kept.end(), [](const Track& a, const Track& b) { return a.id < b.id; });
+  for (Track& tr : kept) {
+    // A frame without a measured motion breaks the travel: no earlier image is shifted past it.
+    if (!tr.moved_now) tr.seen.clear();
+    tr.travel += tr.moved_now.value_or(cv::Point2f(0.f, 0.f));
+    tr.seen.push_back({frame.stamp, tr.travel});
+    if (tr.seen.size() > kSeenFrames) tr.seen.pop_front();
+  }
   tracks_ = std::move(kept);
   return out;
 }

@@ -128,6 +128,7 @@ TEST(BoxFeed, AResultServesOneFrameAndExpires) {
   EXPECT_TRUE(a.fresh);
   EXPECT_EQ(a.boxes.size(), 1u);
   EXPECT_NEAR(a.age_s, 0.05, 1e-9);
+  EXPECT_NEAR(a.boxes[0].age_s, 0.05, 1e-9);  // each box says how old its image is
   // The same result again: no fresh boxes (the tracker carries them).
   EXPECT_FALSE(feed.take(r, 1.08).fresh);
   EXPECT_FALSE(feed.take(std::nullopt, 1.1).fresh);

@@ -249,6 +249,51 @@ TEST(BoxTracker, LowScoreDetectionNotCarried) {
   EXPECT_EQ(tr2.predict(makeFrame(s, 5, 0), {}).size(), 1u);
 }
 
+// Asynchronous detection: a detection of the image two frames back arrives while the person
+// walks 6 px a frame. It is moved by the person's keypoint travel since that image.
+TEST(BoxTracker, StaleDetectionMovedByTheTravelSinceItsImage) {
+  const double dt = 1.0 / 30;
+  const float step = 6.f;
+  for (const bool shift : {true, false}) {
+    Scene s = makeScene(kBox, 40, 100, 12);
+    BoxTrackerOptions o;
+    o.shift_stale = shift;
+    BoxTracker tr(o);
+    for (int k = 0; k < 3; ++k) {
+      features::FeatureFrame f = makeFrame(s, k * step, 0);
+      f.stamp = k * dt;
+      tr.predict(f, k == 0 ? detection::Boxes{personBox(kBox)} : detection::Boxes{}, k == 0);
+      tr.observe(f);
+    }
+    features::FeatureFrame f3 = makeFrame(s, 3 * step, 0);
+    f3.stamp = 3 * dt;
+    detection::Box stale = personBox(cv::Rect2f(kBox.x + step, kBox.y, kBox.width - 10, kBox.height));
+    stale.age_s = 2 * dt;  // the image of frame 1
+    const detection::Boxes out = tr.predict(f3, {stale});
+    ASSERT_EQ(out.size(), 1u) << "shift " << shift;
+    EXPECT_FALSE(out[0].tracked);
+    EXPECT_NEAR(out[0].rect.x, kBox.x + (shift ? 3 : 1) * step, 0.5) << "shift " << shift;
+    EXPECT_NEAR(out[0].rect.width, kBox.width - 10, 1e-3);
+    EXPECT_EQ(tr.numTracks(), 1u);
+  }
+}
+
+TEST(BoxTracker, StaleDetectionOlderThanTheTrackStaysWhereItWasSeen) {
+  Scene s = makeScene(kBox, 40, 100, 13);
+  BoxTracker tr(BoxTrackerOptions{});
+  features::FeatureFrame f0 = makeFrame(s, 0, 0);
+  f0.stamp = 10.0;
+  tr.predict(f0, {personBox(kBox)});
+  tr.observe(f0);
+  features::FeatureFrame f1 = makeFrame(s, 6, 0);
+  f1.stamp = 10.0 + 1.0 / 30;
+  detection::Box stale = personBox(kBox);
+  stale.age_s = 0.5;  // before the track began: its travel is not known
+  const detection::Boxes out = tr.predict(f1, {stale});
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].rect, kBox);
+}
+
 TEST(BoxTracker, OptionsValidated) {
   BoxTrackerOptions o;
   o.max_age = 0;

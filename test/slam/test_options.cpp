@@ -90,6 +90,7 @@ Screening.trackRadius: 35.5
 Screening.trackMaxHamming: 45
 Screening.trackMinMatches: 6
 Screening.trackMinScore: 0.625
+Screening.trackShiftStale: 0
 Screening.staticBoxVeto: 0
 Screening.staticBoxMaxScore: 0.75
 Screening.staticBoxFraction: 0.625
@@ -259,8 +260,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(s.reject_flat_boxes, s.flat_box_fraction, s.flat_box_tolerance, s.flat_box_ring),
             std::make_tuple(true, 0.5, 0.015625, 0.375));
   const screening::BoxTrackerOptions& t = s.tracker;
-  EXPECT_EQ(std::tie(t.enabled, t.max_age, t.radius_px, t.max_hamming, t.min_matches, t.min_score),
-            std::make_tuple(false, 4, 35.5, 45, 6, 0.625));
+  EXPECT_EQ(std::tie(t.enabled, t.max_age, t.radius_px, t.max_hamming, t.min_matches, t.min_score, t.shift_stale),
+            std::make_tuple(false, 4, 35.5, 45, 6, 0.625, false));
   const screening::TemporalOptions& m = s.temporal;
   EXPECT_EQ(std::tie(m.static_box_veto, m.static_box_max_score, m.static_box_fraction, m.static_box_min_points),
             std::make_tuple(false, 0.75, 0.625, 12));

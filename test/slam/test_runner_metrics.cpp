@@ -232,18 +232,19 @@ TEST_F(RunnerMetrics, ModeOffDropsNothing) {
   EXPECT_EQ(js["sequential"], false) << js.dump();
 }
 
+// The second run reads every frame up front (--preload): the same frames in the same order.
 TEST_F(RunnerMetrics, SequentialRunsWriteIdenticalTrajectories) {
   std::string traj[2];
   for (int k = 0; k < 2; ++k) {
     const std::string out = joinPath(dir_, "out_sequential" + std::to_string(k));
+    std::vector<std::string> args{"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential"};
+    if (k == 1) args.push_back("--preload");
     std::string so, se;
-    ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential"},
-                      joinPath(dir_, "sequential" + std::to_string(k)), so, se),
-              0)
-        << so << se;
+    ASSERT_EQ(runTool(args, joinPath(dir_, "sequential" + std::to_string(k)), so, se), 0) << so << se;
     const Json js = statsOf(out);
     EXPECT_EQ(js["sequential"], true) << js.dump();
     EXPECT_EQ(js["settings"]["System.sequential"], true) << js.dump();
+    EXPECT_EQ(js["frames_preloaded"], k == 1) << js.dump();
     traj[k] = readAll(joinPath(out, "CameraTrajectory.txt"));
   }
   EXPECT_FALSE(traj[0].empty());

@@ -17,6 +17,10 @@ struct Box {
   // True for a box screening::BoxTracker carried over from earlier detections (the detector
   // missed the object in this frame); score is then the score of the last detection.
   bool tracked = false;
+  // Asynchronous detection: seconds from the image the detector saw to the frame this box is
+  // screened in (detection::BoxFeed sets it; 0: the detector saw this frame). The box is where
+  // the object was then; screening::BoxTracker moves it to where the object is now.
+  double age_s = 0;
 };
 using Boxes = std::vector<Box>;
 

@@ -19,6 +19,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,9 +52,13 @@ struct BoxTrackerOptions {
   // A predicted box whose area is at least this fraction inside a detection is that detection
   // (the detector's box changed shape too much for the IoU test): no duplicate box.
   double covered_fraction = 0.7;
+  // Asynchronous detection hands a frame boxes of an earlier image (detection::Box::age_s). A
+  // detection of a track is moved by how far the track moved since that image: its box centre
+  // then to now, summed from its keypoints' displacements frame by frame.
+  bool shift_stale = true;
 
   // Reads Screening.trackBoxes, trackMaxAge (frames), trackRadius (px), trackMaxHamming (bits),
-  // trackMinMatches, trackMinScore; throws yolo_slam::Error naming the file and key.
+  // trackMinMatches, trackMinScore, trackShiftStale; throws yolo_slam::Error naming the file and key.
   static BoxTrackerOptions load(const Config& cfg);
   // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "BoxTrackerOptions") const;
@@ -63,7 +69,8 @@ class BoxTracker {
   explicit BoxTracker(const BoxTrackerOptions& options);  // validates
   const BoxTrackerOptions& options() const { return opt_; }
 
-  // The boxes to screen in `frame`: every detection (unchanged, in order), then one box per
+  // The boxes to screen in `frame`: every detection (in order; one older than the frame moved
+  // with its track when shift_stale is on), then one box per
   // live track that no detection covers, moved by the median displacement of its remembered
   // keypoints matched into `frame` and clipped to the image; such boxes have tracked = true.
   // Tracks without enough matches, past max_age or moved out of the image are dropped.
@@ -82,16 +89,35 @@ class BoxTracker {
   size_t numTracks() const { return tracks_.size(); }
 
  private:
+  struct Seen {
+    double stamp;
+    cv::Point2f travel;  // Track::travel after that frame
+  };
+  // Frames a track remembers its travel for: Detection.maxAge (0.2 s) at 30 Hz and more.
+  static constexpr size_t kSeenFrames = 16;
   struct Track {
     long id = 0;
     detection::Box box;              // box used in the current frame
     int age = 0;                     // frames since the last detection
     std::vector<cv::Point2f> pts;    // remembered dynamic keypoints (image pixels)
     cv::Mat desc;                    // their descriptors, rows match pts
+    std::optional<cv::Point2f> moved_now;  // keypoint displacement into the frame in predict()
+    cv::Point2f travel{0.f, 0.f};    // sum of the keypoint displacements since the track began
+    std::deque<Seen> seen;           // travel in the last kSeenFrames frames, oldest first
   };
   // Median displacement of t's remembered keypoints matched into frame; false when fewer than
   // min_matches match.
   bool displacement(const Track& t, const features::FeatureFrame& frame, cv::Point2f& d) const;
+  // For each track, the detection associated to it (-1: none).
+  std::vector<int> associate(const detection::Boxes& detections) const;
+  // t's travel at `stamp` (a frame it saw, or between two), if it remembers that far back
+  // without a frame whose motion was not measured.
+  static std::optional<cv::Point2f> travelAt(const Track& t, double stamp);
+  // `det`, associated to t, moved from where the detector saw the person to this frame.
+  detection::Box placeDetection(const Track& t, const features::FeatureFrame& frame, const detection::Box& det) const;
+  // Moves an undetected track into `frame`; false when it is dropped (too old, weak, lost, out
+  // of view) or one of the `placed` detections already covers it.
+  bool carry(Track& tr, const features::FeatureFrame& frame, const detection::Boxes& placed, bool detector_ran) const;
 
   BoxTrackerOptions opt_;
   std::vector<Track> tracks_;  // ordered by id
