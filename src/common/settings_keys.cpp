@@ -169,6 +169,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Synth.threads",
       "Synth.trajectory",
       "System.sequential",
+      "System.youngMapSync",
       "ThDepth",
       "Tracking.closeMinFrames",
       "Tracking.closeTrackedMax",

@@ -45,6 +45,7 @@ SystemOptions SystemOptions::load(const Config& cfg) {
   o.slam = SlamOptions::load(cfg);
   o.dense = mapping::DenseMapOptions::load(cfg);
   o.sequential = cfg.getBool("System.sequential", o.sequential);
+  o.young_map_sync = cfg.getBool("System.youngMapSync", o.young_map_sync);
   checkInitialisable(o, configName(cfg));
   return o;
 }
@@ -58,6 +59,7 @@ System::System(const CameraModel& cam, const SystemOptions& options,
     : cam_(cam),
       opt_(options.slam),
       run_mode_(options.sequential ? RunMode::Sequential : RunMode::Threaded),
+      young_map_sync_(options.young_map_sync),
       orb_options_(options.orb),
       screening_options_(options.screening),
       voc_(std::move(vocabulary)) {
@@ -253,6 +255,8 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
     resetInternal(true);
   } else if (run_mode_ == RunMode::Sequential) {
     runBackEndInline();
+  } else if (young_map_sync_ && res.keyframe_inserted && tracker_->mapIsYoung()) {
+    mapper_->waitIdle();
   }
   return res;
 }

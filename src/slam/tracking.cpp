@@ -262,6 +262,11 @@ bool Tracking::lostYoung() const {
          lost_frames_in_row_ >= opt_.young_lost_reset_frames;
 }
 
+bool Tracking::mapIsYoung() const {
+  return init_frame_id_ >= 0 && last_tracked_id_ >= init_frame_id_ &&
+         last_tracked_id_ - init_frame_id_ < opt_.young_map_frames;
+}
+
 bool Tracking::youngMap(const Frame& F) const {
   return init_frame_id_ >= 0 && F.id - init_frame_id_ < opt_.young_map_frames;
 }

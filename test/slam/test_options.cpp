@@ -152,6 +152,7 @@ LoopClosing.globalBA: 0
 LoopClosing.globalBAIterations: 8
 LoopClosing.threadNice: 4
 System.sequential: 1
+System.youngMapSync: 0
 DenseMap.enabled: 1
 DenseMap.resolution: 0.125
 DenseMap.maxRange: 3.5
@@ -226,6 +227,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_DOUBLE_EQ(orb.dynamic_boost_max, 1.5);
   EXPECT_EQ(orb.threads, 1);
   EXPECT_TRUE(sys.sequential);
+  EXPECT_FALSE(sys.young_map_sync);
   const mapping::DenseMapOptions& dm = sys.dense;
   EXPECT_EQ(std::tie(dm.enabled, dm.resolution_m, dm.max_range_m, dm.pixel_stride, dm.cloud_resolution_m),
             std::make_tuple(true, 0.125, 3.5, 3, 0.03125));

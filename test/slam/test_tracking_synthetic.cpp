@@ -206,3 +206,46 @@ TEST(SlamTracking, MaxJumpNeverRefusesACameraThatMoves) {
     EXPECT_EQ(run.stats.jumps_refused, 0u) << path;
   }
 }
+
+namespace {
+
+struct YoungRun {
+  Trajectory poses;
+  std::vector<size_t> mapped;  // keyframes local mapping had finished when each frame returned
+};
+
+// The first `frames` frames of the empty room through System (threaded unless opt says otherwise).
+YoungRun youngMapRun(slam::SystemOptions opt, int frames) {
+  sim::SequenceGenerator gen(emptyRoom(5, "", frames));
+  slam::System sys(gen.camera(), opt, nullptr);
+  YoungRun run;
+  for (size_t i = 0; i < gen.size(); ++i) {
+    sim::SynthFrame f = gen.frame(i);
+    sys.trackRgbd(f.bgr, f.depth, f.rgb_stamp, {});
+    run.mapped.push_back(sys.stats().local_mapping_ms.size());
+  }
+  sys.waitForLocalMapping();
+  run.poses = sys.cameraTrajectory();
+  return run;
+}
+
+}  // namespace
+
+// System.youngMapSync: while the map is young a threaded run maps each keyframe before the next
+// frame, so every frame returns with its keyframes mapped and tracks exactly as a sequential run
+// does, whatever the threads' timing.
+TEST(SlamTracking, YoungMapSyncTracksAYoungMapAsSequentialDoes) {
+  const int frames = 20;  // within Tracking.youngMapFrames (30)
+  slam::SystemOptions seq = sequentialNoScreening();
+  ASSERT_LT(frames, seq.slam.tracking.young_map_frames);
+  slam::SystemOptions threaded = seq;
+  threaded.sequential = false;
+  ASSERT_TRUE(threaded.young_map_sync);
+  const YoungRun a = youngMapRun(seq, frames), b = youngMapRun(threaded, frames);
+  EXPECT_GE(a.mapped.back(), 2u);
+  EXPECT_EQ(a.mapped, b.mapped);
+  ASSERT_EQ(a.poses.size(), static_cast<size_t>(frames));
+  ASSERT_EQ(b.poses.size(), a.poses.size());
+  for (size_t i = 0; i < a.poses.size(); ++i)
+    EXPECT_TRUE(a.poses[i].T_wc.matrix() == b.poses[i].T_wc.matrix()) << "frame " << i;
+}

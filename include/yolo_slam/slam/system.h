@@ -106,6 +106,11 @@ struct SystemOptions {
   // caller's thread right after each tracked frame, not in their own threads, so identical
   // input gives bit-identical output (slower: the caller waits for the back end).
   bool sequential = false;
+  // System.youngMapSync (threaded only): while the map is young (Tracking.youngMapFrames since
+  // its initialisation) a frame that made a keyframe waits for local mapping to finish it, as
+  // in sequential mode: a young map has few points, and the next frames need the ones local
+  // mapping triangulates (a crowd covers most of the view).
+  bool young_map_sync = true;
   static SystemOptions load(const Config& cfg);
 };
 
@@ -208,6 +213,7 @@ class System {
   CameraModel cam_;
   SlamOptions opt_;
   const RunMode run_mode_;
+  const bool young_map_sync_;  // SystemOptions::young_map_sync
   features::OrbOptions orb_options_;
   screening::ScreeningOptions screening_options_;
   // Made by the first trackRgbd (trackFeatures callers, the ROS Slam nodelet, screen frames

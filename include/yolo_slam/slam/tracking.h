@@ -55,6 +55,8 @@ class Tracking {
   void setLocalizationOnly(bool on) { localization_only_ = on; }
   bool localizationOnly() const { return localization_only_; }
   TrackingState state() const { return state_; }
+  // The last frame was tracked within young_map_frames of its map's initialisation.
+  bool mapIsYoung() const;
   // The keyframe the last track() made (when its TrackResult says keyframe_inserted).
   const KeyFramePtr& lastKeyFrame() const { return last_kf_; }
 
