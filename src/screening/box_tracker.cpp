@@ -160,12 +160,14 @@ bool BoxTracker::carry(Track& tr, const features::FeatureFrame& frame, const det
 detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
                                      const detection::Boxes& detections, bool detector_ran) {
   const std::vector<int> track_det = associate(detections);
+  for (const auto& b : detections) stream_has_stale_ = stream_has_stale_ || b.age_s > 0;
   // How far each track's keypoints moved since the last frame: carries undetected tracks, and
-  // (shift_stale) measures the person's travel that a detection of an earlier image missed.
+  // (shift_stale, on a stream with detections of earlier images) measures the person's travel
+  // that such a detection missed.
   for (size_t t = 0; t < tracks_.size(); ++t) {
     Track& tr = tracks_[t];
     cv::Point2f d;
-    const bool needed = track_det[t] < 0 || opt_.shift_stale;
+    const bool needed = track_det[t] < 0 || (opt_.shift_stale && stream_has_stale_);
     tr.moved_now = needed && displacement(tr, frame, d) ? std::optional<cv::Point2f>(d) : std::nullopt;
   }
   detection::Boxes out = detections;

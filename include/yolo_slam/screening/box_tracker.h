@@ -121,6 +121,9 @@ class BoxTracker {
 
   BoxTrackerOptions opt_;
   std::vector<Track> tracks_;  // ordered by id
+  // A detection of an earlier image has been seen (asynchronous detection): only then is every
+  // track's travel measured in every frame (every-frame detection never needs it).
+  bool stream_has_stale_ = false;
   long next_id_ = 0;
 };
 
