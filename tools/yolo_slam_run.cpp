@@ -378,6 +378,7 @@ struct RunSetup {
   std::unique_ptr<detection::Detector> detector;       // every-frame detection
   std::unique_ptr<detection::AsyncDetector> async;     // Detection.async (then detector is null)
   double max_box_age_s = 0;                            // Detection.maxAge
+  int max_lag_frames = 0;  // Detection.asyncMaxLag, full-speed runs only (0 at camera pace)
   std::string boxes_source = "none";
   std::shared_ptr<const vocabulary::Vocabulary> voc;
   std::string mask_dir;  // synthetic sequences: per-frame masks, masks/<rgb file name>
@@ -405,6 +406,7 @@ void setUpBoxes(const Args& args, RunSetup& r) {
       r.async = std::make_unique<detection::AsyncDetector>(std::move(r.detector), aopt.min_interval_s,
                                                           aopt.thread_nice);
       r.max_box_age_s = aopt.max_age_s;
+      if (!args.realtime && !args.camera_rate) r.max_lag_frames = aopt.max_lag_frames;
       r.boxes_source += " (async)";
     }
   }
@@ -646,6 +648,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
                       LoopResult& res) {
   if (!setup.async || !p.has_image) return;
   setup.async->offer(p.bgr, static_cast<long>(p.index), p.stamp);
+  if (setup.max_lag_frames > 0) setup.async->waitForFrame(static_cast<long>(p.index) - setup.max_lag_frames);
   const std::optional<detection::DetectionResult> newest = setup.async->newest();
   const long expired_before = feed.expired();
   const detection::FrameBoxes fb = feed.take(newest, p.stamp);

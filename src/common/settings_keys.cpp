@@ -66,6 +66,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Detection.asyncThreads",
       "Detection.maxAge",
       "Detection.threadNice",
+      "Detection.asyncMaxLag",
       "Detector.confThreshold",
       "Detector.dynamicClasses",
       "Detector.extraModels",

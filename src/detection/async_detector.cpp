@@ -18,6 +18,7 @@ AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
   o.threads = readInt(cfg, "Detection.asyncThreads", o.threads, Range::closed(1, DetectorOptions::kMaxThreads));
   o.min_interval_s = readDouble(cfg, "Detection.asyncMinInterval", o.min_interval_s, Range::atLeast(0));
   o.thread_nice = readInt(cfg, "Detection.threadNice", o.thread_nice, Range::closed(0, 19));
+  o.max_lag_frames = readInt(cfg, "Detection.asyncMaxLag", o.max_lag_frames, Range::atLeast(0));
   return o;
 }
 
@@ -62,6 +63,13 @@ std::optional<DetectionResult> AsyncDetector::newest() const {
 void AsyncDetector::waitIdle() {
   std::unique_lock<std::mutex> lk(mutex_);
   cv_.wait(lk, [this] { return stop_ || (!pending_ && !busy_); });
+}
+
+bool AsyncDetector::waitForFrame(long index) {
+  std::unique_lock<std::mutex> lk(mutex_);
+  const auto arrived = [this, index] { return newest_ && newest_->frame >= index; };
+  cv_.wait(lk, [&] { return stop_ || arrived() || (!pending_ && !busy_); });
+  return arrived();
 }
 
 bool AsyncDetector::admitLocked(double stamp) const {

@@ -102,6 +102,29 @@ TEST(AsyncDetector, AMinimumIntervalKeepsFramesFromTheDetector) {
   EXPECT_EQ(async.newest()->frame, 30);
 }
 
+TEST(AsyncDetector, WaitForFrameReturnsOnceAResultThatRecentIsThere) {
+  auto gated = std::make_unique<GatedDetector>();
+  GatedDetector* gate = gated.get();
+  AsyncDetector async(std::move(gated));
+  async.offer(imageOf(5), 5, 0.0);
+  std::atomic<bool> returned{false};
+  bool got = false;
+  std::thread waiter([&] {
+    got = async.waitForFrame(4);
+    returned = true;
+  });
+  while (gate->started() < 1) std::this_thread::yield();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(returned.load());  // frame 5 is still being detected: the stream waits
+  gate->open();
+  waiter.join();
+  EXPECT_TRUE(got);
+  EXPECT_EQ(async.newest()->frame, 5);
+  EXPECT_TRUE(async.waitForFrame(5));  // already there: no wait
+  // Nothing newer is queued or detected: the wait ends without the result it asked for.
+  EXPECT_FALSE(async.waitForFrame(9));
+}
+
 TEST(AsyncDetector, TheDetectionThreadRunsAtDetectionThreadNice) {
   const int base = getpriority(PRIO_PROCESS, 0);
   AsyncDetector async(std::make_unique<InstantDetector>(), 0, 6);
@@ -156,6 +179,9 @@ TEST(AsyncDetectionOptions, LoadsAndRejectsNegativeAge) {
       Config::fromString("Detection.asyncThreads: 2\nDetection.asyncMinInterval: 0.1\n"));
   EXPECT_EQ(t.threads, 2);
   EXPECT_DOUBLE_EQ(t.min_interval_s, 0.1);
+  EXPECT_EQ(d.max_lag_frames, 3);
+  EXPECT_EQ(AsyncDetectionOptions::load(Config::fromString("Detection.asyncMaxLag: 0\n")).max_lag_frames, 0);
+  EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.asyncMaxLag: -1\n", "bad.yaml")), Error);
   EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.asyncThreads: 0\n", "bad.yaml")), Error);
   EXPECT_THROW(AsyncDetectionOptions::load(Config::fromString("Detection.asyncMinInterval: -0.1\n", "bad.yaml")),
                Error);

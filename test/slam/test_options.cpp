@@ -60,6 +60,7 @@ Detection.maxAge: 0.375
 Detection.asyncThreads: 2
 Detection.asyncMinInterval: 0.05
 Detection.threadNice: 2
+Detection.asyncMaxLag: 5
 Screening.mode: "detect"
 Screening.variant: "grow"
 Screening.varianceThreshold: 0.03125
@@ -243,7 +244,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(320, 256, false, 0.375f, 0.5f, 3));
   EXPECT_EQ(d.dynamic_classes, std::vector<std::string>{"person"});
   const detection::AsyncDetectionOptions a = detection::AsyncDetectionOptions::load(cfg);
-  EXPECT_EQ(std::tie(a.enabled, a.max_age_s), std::make_tuple(true, 0.375));
+  EXPECT_EQ(std::tie(a.enabled, a.max_age_s, a.threads, a.min_interval_s, a.thread_nice, a.max_lag_frames),
+            std::make_tuple(true, 0.375, 2, 0.05, 2, 5));
 
   const screening::ScreeningOptions& s = sys.screening;
   using screening::DynamicMode;

@@ -352,6 +352,25 @@ TEST_F(RunnerMetrics, CameraRateAndAsyncDetectionAccountForEveryFrame) {
   if (!kThreadSanitizer) EXPECT_GE(numberOf(det, "frames_with_new_boxes"), 1) << det.dump();
 }
 
+// Full speed with Detection.asyncMaxLag 1: a frame waits until the detector has seen the frame
+// before it, so every frame is detected and each result reaches a frame (the first frame gets
+// its own: no frame awaits detection).
+TEST_F(RunnerMetrics, AsyncMaxLagBoundsHowOldAFramesBoxesAre) {
+  const std::string out = joinPath(dir_, "out_lag");
+  std::string so, se;
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--detection", "async", "--preload", "--max-frames", "12",
+                     "--min-tracked", "0", "--set", "Detection.asyncMaxLag=1"},
+                    joinPath(dir_, "lag"), so, se),
+            0)
+      << so << se;
+  const Json js = statsOf(out);
+  const Json det = js["detection"];
+  EXPECT_EQ(numberOf(det, "offered"), 12) << det.dump();
+  EXPECT_EQ(numberOf(det, "detected"), 12) << det.dump();
+  EXPECT_GE(numberOf(det, "frames_with_new_boxes"), 11) << det.dump();
+  EXPECT_EQ(numberOf(js, "awaiting_detection"), 0) << js.dump();
+}
+
 TEST_F(RunnerMetrics, SavedMapIsLoadedForLocalization) {
   const std::string map = joinPath(dir_, "walking.ysmap");
   std::string so, se;

@@ -43,6 +43,12 @@ struct AsyncDetectionOptions {
   // detection: the offline runner's worker, the Detector nodelet's own thread), so that on a
   // busy CPU the frame stream goes first; the boxes then come less often.
   int thread_nice = 0;
+  // Detection.asyncMaxLag (frames; yolo_slam_run at full speed only): a frame whose newest
+  // result is of an image more than this many frames older waits for a newer one. At full speed
+  // frames come faster than a camera's and the detector sees one in three or four: people
+  // entering the view get their box frames late. A camera (--camera-rate, --realtime, ROS)
+  // never waits: there the detector keeps up. 0: never wait.
+  int max_lag_frames = 3;
   static AsyncDetectionOptions load(const Config& cfg);  // throws Error naming file and key
 };
 
@@ -72,6 +78,9 @@ class AsyncDetector {
   std::optional<DetectionResult> newest() const;
   // Blocks until no frame waits and none is being detected (tests, end of a sequence).
   void waitIdle();
+  // Blocks until the newest result is of frame `index` or later, or nothing more will come (no
+  // frame waits or is being detected); returns whether such a result is there.
+  bool waitForFrame(long index);
   AsyncDetectionCounts counts() const;
   const Detector& detector() const { return *detector_; }
 
