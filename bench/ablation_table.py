@@ -286,17 +286,20 @@ def main():
 
     # Dynamic keypoints no box covered (people the detector missed or cut, things they carry).
     o.append("\n### Dynamic keypoints outside every box: per frame (median of runs) and the share dropped; "
-             "static keypoints dropped\n")
+             "static keypoints dropped (in brackets: of the static keypoints whose FAST circle does not reach a "
+             "person, the share dropped)\n")
 
     def outside_text(c):
         frames = c.m(lambda r: find_key(r["stats"], {"frames"}))
         outside = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_boxes"}))
         dropped = c.m(lambda r: find_key(r["stats"], {"dynamic_outside_dropped"}))
         static = c.m(lambda r: find_key(r["stats"], {"static_drop_rate"}))
+        off_outline = c.m(lambda r: find_key(r["stats"], {"static_drop_rate_off_outline"}))
         if outside is None:
             return "-"
         share = f"{100 * dropped / outside:.1f} %" if outside and dropped is not None else "-"
-        return f"{fmt(outside / max(1, frames or 1), 1)}, {share} dropped; static {fmt(static, 3)}"
+        off = f" ({fmt(off_outline, 3)} off outlines)" if off_outline is not None else ""
+        return f"{fmt(outside / max(1, frames or 1), 1)}, {share} dropped; static {fmt(static, 3)}{off}"
 
     mode_rows(outside_text)
 

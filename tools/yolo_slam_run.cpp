@@ -955,11 +955,12 @@ void printSummary(const RunSetup& setup, const LoopResult& res, const AteSummary
   const screening::ScreeningMetrics& m = res.metrics.sum;
   if (res.metrics.frames > 0)
     std::printf("screening vs masks over %zu frames: dynamic recall %s (on people %s), static retention "
-                "in boxes %s, static dropped %s\n",
+                "in boxes %s, static dropped %s (%s off people's outlines)\n",
                 res.metrics.frames, percent(m.dynamic_dropped, m.dynamic_total).c_str(),
                 percent(m.person_dropped, m.person_total).c_str(),
                 percent(m.static_in_boxes_kept, m.static_in_boxes).c_str(),
-                percent(m.static_dropped, m.static_total).c_str());
+                percent(m.static_dropped, m.static_total).c_str(),
+                percent(m.static_dropped - m.static_on_outline_dropped, m.static_total - m.static_on_outline).c_str());
   if (setup.stages.box_tracking)
     std::printf("boxes screened: %ld from the detector, %ld carried by the box tracker\n", s.boxes.detected,
                 s.boxes.tracked);

@@ -6,6 +6,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/option_checks.h"
 #include "yolo_slam/common/timing.h"
+#include "yolo_slam/features/orb_extractor.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -666,6 +667,15 @@ double ScreeningMetrics::staticRetention() const {
   return static_in_boxes > 0 ? static_cast<double>(static_in_boxes_kept) / static_in_boxes : 1.0;
 }
 
+double ScreeningMetrics::staticDropRate() const {
+  return static_total > 0 ? static_cast<double>(static_dropped) / static_total : 0.0;
+}
+
+double ScreeningMetrics::staticDropRateOffOutline() const {
+  const int total = static_total - static_on_outline;
+  return total > 0 ? static_cast<double>(static_dropped - static_on_outline_dropped) / total : 0.0;
+}
+
 ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
   dynamic_total += o.dynamic_total;
   dynamic_dropped += o.dynamic_dropped;
@@ -677,6 +687,8 @@ ScreeningMetrics& ScreeningMetrics::operator+=(const ScreeningMetrics& o) {
   static_in_boxes_kept += o.static_in_boxes_kept;
   static_total += o.static_total;
   static_dropped += o.static_dropped;
+  static_on_outline += o.static_on_outline;
+  static_on_outline_dropped += o.static_on_outline_dropped;
   return *this;
 }
 
@@ -698,7 +710,11 @@ void to_json(Json& j, const ScreeningMetrics& m) {
            {"static_retention", jsonRatio(m.static_in_boxes_kept, m.static_in_boxes)},
            {"static_keypoints", m.static_total},
            {"static_dropped", m.static_dropped},
-           {"static_drop_rate", jsonRatio(m.static_dropped, m.static_total)}};
+           {"static_drop_rate", jsonRatio(m.static_dropped, m.static_total)},
+           {"static_on_outline", m.static_on_outline},
+           {"static_on_outline_dropped", m.static_on_outline_dropped},
+           {"static_drop_rate_off_outline", jsonRatio(m.static_dropped - m.static_on_outline_dropped,
+                                                      m.static_total - m.static_on_outline)}};
 }
 
 ScreeningStats& ScreeningStats::operator+=(const ScreeningStats& o) {
@@ -725,6 +741,16 @@ void to_json(Json& j, const ScreeningStats& s) {
            {"iterations", s.iterations}};
 }
 
+namespace {
+
+// A static keypoint whose FAST circle (its radius at the keypoint's pyramid level) reaches a
+// dynamic pixel, `to_dynamic` pixels from its centre.
+bool onOutline(const cv::KeyPoint& kp, float to_dynamic) {
+  return to_dynamic <= features::OrbExtractor::kFastRadius * features::OrbExtractor::levelScale(kp);
+}
+
+}  // namespace
+
 ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv::Mat& mask,
                                    const detection::Boxes& boxes, int ignore_border_px) {
   if (mask.empty() || mask.type() != CV_8UC1)
@@ -743,6 +769,9 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
     cv::erode(bin, core_dyn, k);
     cv::dilate(bin, near_dyn, k);
   }
+  // Distance of every pixel to the nearest dynamic pixel, for the outline test.
+  cv::Mat to_dynamic;
+  cv::distanceTransform(mask <= 127, to_dynamic, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   ScreeningMetrics m;
   for (size_t i = 0; i < frame.keypoints.size(); ++i) {
     const cv::Point2f& p = frame.keypoints[i].pt;
@@ -769,6 +798,10 @@ ScreeningMetrics evaluateScreening(const features::FeatureFrame& frame, const cv
     }
     ++m.static_total;
     m.static_dropped += dropped ? 1 : 0;
+    if (onOutline(frame.keypoints[i], to_dynamic.at<float>(y, x))) {
+      ++m.static_on_outline;
+      m.static_on_outline_dropped += dropped ? 1 : 0;
+    }
     if (in_box) {
       ++m.static_in_boxes;
       m.static_in_boxes_kept += dropped ? 0 : 1;

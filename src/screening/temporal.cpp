@@ -39,10 +39,8 @@ float depthOf(const features::FeatureFrame& f, size_t i) {
 }
 
 // Keypoints of coarser pyramid levels are located less precisely: distances are measured in
-// units of the level's scale (the keypoint's size is the patch diameter times the scale).
-double levelScale(const cv::KeyPoint& kp) {
-  return std::max(1.0, kp.size / double(features::OrbExtractor::kPatchSize));
-}
+// units of the level's scale.
+double levelScale(const cv::KeyPoint& kp) { return features::OrbExtractor::levelScale(kp); }
 
 const OptionTable<TemporalOptions>& temporalFields() {
   using O = TemporalOptions;

@@ -367,6 +367,29 @@ TEST(Metrics, DynamicKeypointsOutsideEveryBoxAreCountedApart) {
   EXPECT_EQ(Json(m)["dynamic_outside_boxes"], 2) << Json(m).dump();
 }
 
+TEST(Metrics, StaticKeypointsOnAPersonsOutlineAreCountedApart) {
+  cv::Mat mask(100, 100, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(40, 0, 20, 100)).setTo(255);  // a person from x = 40 to 59
+  // Static (off the mask): 37 and 62 are 3 px from it (their FAST circle reaches the person),
+  // 30 is 10 px away at level 0 but 3 px at a level of scale 3.6, 10 and 90 are far. Dropped:
+  // 37, 30 and 10.
+  features::FeatureFrame f = rowFrame({37.f, 62.f, 30.f, 10.f, 90.f}, {1, 0, 1, 1, 0});
+  f.keypoints[2].size = 31.f * 3.6f;
+  const ScreeningMetrics m = evaluateScreening(f, mask, oneBox(cv::Rect2f(0, 0, 100, 100)));
+  EXPECT_EQ(m.static_total, 5);
+  EXPECT_EQ(m.static_dropped, 3);
+  EXPECT_EQ(m.static_on_outline, 3);
+  EXPECT_EQ(m.static_on_outline_dropped, 2);
+  EXPECT_DOUBLE_EQ(m.staticDropRate(), 0.6);
+  EXPECT_DOUBLE_EQ(m.staticDropRateOffOutline(), 0.5);  // 10 dropped, 90 kept
+  ScreeningMetrics sum = m;
+  sum += m;
+  EXPECT_EQ(sum.static_on_outline_dropped, 4);
+  const Json j(m);
+  EXPECT_EQ(j["static_on_outline"], 3) << j.dump();
+  EXPECT_DOUBLE_EQ(j["static_drop_rate_off_outline"].get<double>(), 0.5);
+}
+
 TEST(NearestVariant, PersonIsTheNearestClusterWhenTheBackgroundDominatesTheBox) {
   // A sitting person (60 keypoints, 1.8-2.0 m) in a box filled mostly by a desk/wall at 3.5 m
   // (150 keypoints): Algorithm 1's "largest set" is the background, the nearest sizeable

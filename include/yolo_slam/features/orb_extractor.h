@@ -4,6 +4,7 @@
 // level, intensity-centroid orientation and rotated BRIEF (256 bits) on a blurred image.
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,10 @@ class OrbExtractor {
   static constexpr int kDescriptorBytes = 32;  // 256 BRIEF tests
 
   explicit OrbExtractor(const OrbOptions& options);
+
+  // The scale of a keypoint's pyramid level (its size is kPatchSize times it; at least 1):
+  // pixel distances around a keypoint of a coarser level grow by it.
+  static double levelScale(const cv::KeyPoint& kp) { return std::max(1.0, kp.size / double(kPatchSize)); }
 
   // gray: CV_8UC1 (throws yolo_slam::Error otherwise). Keypoints are in level-0 pixel
   // coordinates, ordered by level; octave = level, size = 31 * scale^level, angle in degrees

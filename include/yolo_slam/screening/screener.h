@@ -233,6 +233,11 @@ struct ScreeningMetrics {
   int static_in_boxes_kept = 0;   // of those, left static
   int static_total = 0;           // keypoints off the mask anywhere
   int static_dropped = 0;         // of those, marked dynamic (false positives)
+  // Of static_total, keypoints on a person's outline: their FAST circle (OrbExtractor::kFastRadius
+  // pixels at their pyramid level) reaches a pixel of the mask, so the corner was made by the
+  // moving outline and moves with it, though its centre pixel is off the mask.
+  int static_on_outline = 0;
+  int static_on_outline_dropped = 0;  // of those, marked dynamic
 
   // dynamic_dropped / dynamic_total (1 when there is no dynamic keypoint).
   double dynamicRecall() const;
@@ -243,13 +248,18 @@ struct ScreeningMetrics {
   double dynamicRecallInBoxes() const;
   // static_in_boxes_kept / static_in_boxes (1 when there is no static keypoint in a box).
   double staticRetention() const;
+  // static_dropped / static_total, and the same without the keypoints on an outline (0 when
+  // there is no static keypoint).
+  double staticDropRate() const;
+  double staticDropRateOffOutline() const;
   ScreeningMetrics& operator+=(const ScreeningMetrics& o);
 };
 // {"dynamic_keypoints", "dropped", "dynamic_recall", "dynamic_outside_boxes",
 //  "dynamic_outside_dropped", "dynamic_recall_in_boxes", "person_keypoints", "person_dropped",
 //  "person_recall", "object_keypoints", "object_recall" (moving objects that are not people:
 //  a carried or moved box), "static_in_boxes", "kept", "static_retention", "static_keypoints",
-//  "static_dropped", "static_drop_rate"}; a ratio without a denominator is null.
+//  "static_dropped", "static_drop_rate", "static_on_outline", "static_on_outline_dropped",
+//  "static_drop_rate_off_outline"}; a ratio without a denominator is null.
 void to_json(Json& j, const ScreeningMetrics& m);
 
 // Compares a screened frame with a ground-truth mask (CV_8UC1, same size as the image,
