@@ -20,7 +20,7 @@
 #             Screening.growOutside=0: the person mask, its growth and the hole rule off)
 #   :single   the main detection model alone, without Detector.extraModels (--single-model)
 #   :every / :async   detection on every frame before it is screened (the paper's pipeline,
-#             the measurements before 2026-12-01) / asynchronous detection (the default)
+#             the default of yolo_slam_run) / asynchronous detection (the ROS launch files' default)
 #   :seq      the deterministic mode (--sequential): one run is all runs
 #   :orbkf    ORB-SLAM2's keyframe rules (Tracking.closeMinFrames=0, Tracking.keyFramePoints=100):
 #             "off:orbkf" is ORB-SLAM2 itself; plain "off" is this SLAM without screening

@@ -178,6 +178,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.initMinDepthPoints",
       "Tracking.initMinKeyPoints",
       "Tracking.keyFramePoints",
+      "Tracking.localMapFromPrediction",
       "Tracking.localWindow",
       "Tracking.lostResetFrames",
       "Tracking.lostResetMaxKeyFrames",

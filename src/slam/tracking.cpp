@@ -164,7 +164,7 @@ TrackResult Tracking::trackFirst(Frame& F) {
 }
 
 bool Tracking::trackFrame(Frame& F) {
-  bool ok = false;
+  bool ok = false, from_prediction = false;
   const bool predicted = state_ == TrackingState::Ok && has_last_ && has_velocity_;
   const Pose prediction = predicted ? Pose(velocity_ * last_.T_cw) : Pose::Identity();
   if (predicted && opt_.motion_prior > 0) prior_ = motionPrior(F, prediction);
@@ -172,6 +172,10 @@ bool Tracking::trackFrame(Frame& F) {
     if (has_velocity_) ok = trackMotionModel(F);
     if (!ok && ref_kf_ && !ref_kf_->bad)
       ok = trackReferenceKeyFrame(F, ref_kf_, last_.T_cw, kMinMapMatches);
+    if (!ok && predicted && opt_.local_map_from_prediction) {
+      startFromPrediction(F, prediction);
+      ok = from_prediction = true;
+    }
   } else {
     ok = trackWhenLost(F);
   }
@@ -181,7 +185,14 @@ bool Tracking::trackFrame(Frame& F) {
     ++jumps_refused_;
     ok = false;
   }
-  return ok && finitePose(F.T_cw);
+  ok = ok && finitePose(F.T_cw);
+  if (ok && from_prediction) ++from_prediction_;
+  return ok;
+}
+
+void Tracking::startFromPrediction(Frame& F, const Pose& prediction) const {
+  clearAssociations(F);
+  F.setPose(prediction);
 }
 
 optimization::PosePrior Tracking::motionPrior(const Frame& F, const Pose& prediction) const {
@@ -557,6 +568,7 @@ void Tracking::updateLocalMap(Frame& F) {
   for (const auto& mp : F.points)
     if (mp)
       for (const auto& o : mp->observations) counter[o.first]++;
+  // Without associations (startFromPrediction) the last frame's local map stays.
   if (counter.empty()) return;
   local_kfs_.clear();
   std::set<long> in_local;

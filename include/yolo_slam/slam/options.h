@@ -52,6 +52,11 @@ struct TrackingOptions {
   double max_jump_deg = 10.0;       // Tracking.maxJumpDeg
   int max_jump_inliers = 100;       // Tracking.maxJumpInliers
   double max_stamp_gap = 1.0;       // Tracking.maxStampGap (s): a larger gap drops the motion model
+  // Beyond ORB-SLAM2: when the motion model and the reference keyframe both fail on a frame the
+  // constant-velocity model predicts, the local map is searched from the prediction (the
+  // local-map step, min_inliers as always). A person crossing close to the camera hides what
+  // the last frame and the reference keyframe saw, while the local map holds the room behind.
+  bool local_map_from_prediction = true;  // Tracking.localMapFromPrediction
 
   static TrackingOptions load(const Config& cfg);
 };

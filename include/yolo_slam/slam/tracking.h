@@ -69,6 +69,8 @@ class Tracking {
   size_t relocalizations() const { return relocalizations_; }
   // Frames whose pose was refused as a jump from the motion model (Tracking.maxJump).
   size_t jumpsRefused() const { return jumps_refused_; }
+  // Frames tracked from the motion model's prediction alone (Tracking.localMapFromPrediction).
+  size_t trackedFromPrediction() const { return from_prediction_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -98,6 +100,9 @@ class Tracking {
   void acceptFrame(const Frame& F, TrackResult& res);
   bool initialize(Frame& F);
   bool trackMotionModel(Frame& F);
+  // Tracking.localMapFromPrediction: F starts at `prediction` without associations, so that
+  // trackLocalMap searches the last frame's local map from there.
+  void startFromPrediction(Frame& F, const Pose& prediction) const;
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
   // Projection search of kf's static points not yet matched in F, window th.
   int searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const;
@@ -169,6 +174,7 @@ class Tracking {
   // optimisation of that frame uses it.
   std::optional<optimization::PosePrior> prior_;
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
+  size_t from_prediction_ = 0;
 };
 
 }  // namespace slam
