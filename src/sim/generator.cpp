@@ -627,6 +627,9 @@ void SequenceGenerator::renderFrames(const std::string& out_dir, bool progress,
       next = n;
     }
   };
+  // OpenCV creates the operator object behind cv::Mat::zeros on first use, in code TSan does not
+  // see; created here, before the workers start, no two workers race to create it.
+  cv::Mat::zeros(1, 1, CV_8U).operator cv::Mat();
   std::vector<std::thread> pool;
   for (int k = 1; k < opt_.threads; ++k) pool.emplace_back(work);
   work();
