@@ -77,6 +77,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Detector.nmsThreshold",
       "Detector.threads",
       "LocalMapping.cullingRedundancy",
+      "LocalMapping.freeSpaceRatio",
       "LocalMapping.fuseNeighbours",
       "LocalMapping.localBA",
       "LocalMapping.queueSize",

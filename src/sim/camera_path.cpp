@@ -107,9 +107,10 @@ Pose CameraPath::at(double t) const {
     return anchor_ * L;
   } else if (name_ == "loop") {
     // A circle of radius r about a centre r ahead, always facing the centre: the camera sweeps
-    // the whole room once and comes back to its start pose at t = duration.
+    // the whole room once, comes back to its start pose at t = duration and goes on round, so
+    // that a sequence longer than the duration revisits the start over several keyframes.
     const double r = 0.8;
-    double a = w * std::min(std::max(t, 0.0), duration_) / duration_;
+    double a = w * std::max(t, 0.0) / duration_;
     Eigen::Vector3d pos(r * std::sin(a), 0.05 * std::sin(2 * a), r - r * std::cos(a));
     R = Eigen::AngleAxisd(a, -Eigen::Vector3d::UnitY()).toRotationMatrix();
     Pose T = Pose::Identity();

@@ -238,7 +238,7 @@ const std::vector<PresetInfo>& presets() {
       {"walking_half", "halfsphere", "two people walking, one carrying a box; camera on a half sphere", 1067, 2, 0, true, kMidRoomPaths},
       {"sitting_static", "static", "two people sitting at the desks, moving slightly", 707, 0, 2, false, {}},
       {"static_xyz", "xyz", "no people; camera translating along its axes", 900, 0, 0, false, {}},
-      {"loop", "loop", "one walker; the camera circles the room and returns to its start", 1200, 1, 0, false, kLoopPath},
+      {"loop", "loop", "one walker; the camera circles the room, returns to its start and goes on a sixth of the way round", 1400, 1, 0, false, kLoopPath},
       {"crowd", "replay", "seven people crossing and occluding each other, one carrying a box; the real fr3_walking_xyz camera motion", 860, 7, 0, true, kCrowdPaths},
       {"close", "replay", "three people, two of them close to the camera (one crossing 0.8 m in front of it, one walking up to 0.75 m); the real fr3_walking_xyz camera motion", 827, 3, 0, false, kClosePaths},
       {"moved_object", "xyz", "a person picks up a box standing on the floor, carries it and puts it down; camera translating along its axes", 600, 1, 0, true, {}, kMoveBoxWalk, kMoveBoxTimes},

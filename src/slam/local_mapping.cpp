@@ -8,12 +8,12 @@
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
 #include "yolo_slam/slam/observation.h"
+#include "yolo_slam/slam/triangulation.h"
 #include "yolo_slam/common/thread_name.h"
-
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <unordered_map>
 
@@ -249,119 +249,23 @@ void LocalMapping::mapPointCulling() {
   }
 }
 
-namespace {
-
-bool triangulate(const Eigen::Vector3d& xn1, const Eigen::Vector3d& xn2, const Pose& T1,
-                 const Pose& T2, Eigen::Vector3d& X) {
-  Eigen::Matrix<double, 3, 4> P1 = T1.matrix().topRows<3>(), P2 = T2.matrix().topRows<3>();
-  Eigen::Matrix4d A;
-  A.row(0) = xn1.x() * P1.row(2) - P1.row(0);
-  A.row(1) = xn1.y() * P1.row(2) - P1.row(1);
-  A.row(2) = xn2.x() * P2.row(2) - P2.row(0);
-  A.row(3) = xn2.y() * P2.row(2) - P2.row(1);
-  Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
-  Eigen::Vector4d h = svd.matrixV().col(3);
-  if (std::fabs(h(3)) < 1e-12) return false;
-  X = h.head<3>() / h(3);
-  return X.allFinite();
-}
-
-}  // namespace
-
-namespace {
-
-// ORB-SLAM2 CreateNewMapPoints: distance ratio against octave ratio tolerance (x scale factor),
-// rays more parallel than this cosine are not triangulated without depth, chi2 bounds of the
-// reprojection (2 dof 95%, and ORB-SLAM2's 7.8 for 3 dof).
-constexpr double kScaleConsistency = 1.5;
-constexpr double kMaxParallaxCos = 0.9998;
-constexpr double kTriangulationChi2Mono = 5.991;
-constexpr double kTriangulationChi2Stereo = 7.8;
-
-// One keyframe of a triangulation pair.
-struct View {
-  const KeyFrame& kf;
-  Pose T;                 // T_cw
-  Eigen::Vector3d O;      // camera centre
-  Eigen::Matrix3d R_wc;
-};
-
-View viewOf(const KeyFrame& kf) {
-  const Pose T = kf.Tcw();
-  return {kf, T, kf.center(), T.linear().transpose()};
-}
-
-// A new point's reprojection in a keyframe is within the chi2 bound of its octave.
-bool reprojectionOk(const CameraModel& cam, const ScalePyramid& pyr, const Eigen::Vector3d& pc,
-                    const cv::KeyPoint& kp, double ur, bool stereo) {
-  const Eigen::Vector2d uv = cam.project(pc);
-  const double ex = uv.x() - kp.pt.x, ey = uv.y() - kp.pt.y;
-  const double s2 = pyr.sigma2[kp.octave];
-  if (!stereo) return ex * ex + ey * ey <= kTriangulationChi2Mono * s2;
-  const double er = uv.x() - cam.bf / pc.z() - ur;
-  return ex * ex + ey * ey + er * er <= kTriangulationChi2Stereo * s2;
-}
-
-// The point of the match (keypoint i1 of v1, i2 of v2): triangulated when the rays' parallax
-// beats the depth's, else back-projected from the better depth; false if it fails the depth,
-// reprojection or scale-consistency checks (ORB-SLAM2 CreateNewMapPoints).
-bool triangulateMatch(const CameraModel& cam, const View& v1, const View& v2, size_t i1, size_t i2,
-                      const Eigen::Matrix3d& Kinv, Eigen::Vector3d& X) {
-  const Frame& f1 = v1.kf.f;
-  const Frame& f2 = v2.kf.f;
-  const auto& pyr = *f1.pyramid;
-  const cv::KeyPoint& k1 = f1.kps[i1];
-  const cv::KeyPoint& k2 = f2.kps[i2];
-  const double ur1 = f1.right_u[i1], ur2 = f2.right_u[i2];
-  const bool stereo1 = ur1 >= 0, stereo2 = ur2 >= 0;
-  const Eigen::Vector3d xn1 = Kinv * Eigen::Vector3d(k1.pt.x, k1.pt.y, 1.0);
-  const Eigen::Vector3d xn2 = Kinv * Eigen::Vector3d(k2.pt.x, k2.pt.y, 1.0);
-  const Eigen::Vector3d ray1 = v1.R_wc * xn1, ray2 = v2.R_wc * xn2;
-  const double cos_rays = ray1.dot(ray2) / (ray1.norm() * ray2.norm());
-  const double b = cam.baseline();
-  const double cos_st1 = stereo1 ? std::cos(2 * std::atan2(b / 2, f1.depth[i1])) : 2.0;
-  const double cos_st2 = stereo2 ? std::cos(2 * std::atan2(b / 2, f2.depth[i2])) : 2.0;
-  const double cos_st = std::min(cos_st1, cos_st2);
-  if (cos_rays < cos_st && cos_rays > 0 && (stereo1 || stereo2 || cos_rays < kMaxParallaxCos)) {
-    if (!triangulate(xn1, xn2, v1.T, v2.T, X)) return false;
-  } else if (stereo1 && cos_st1 < cos_st2) {
-    if (!f1.unprojectWorld(i1, X)) return false;
-  } else if (stereo2 && cos_st2 < cos_st1) {
-    if (!f2.unprojectWorld(i2, X)) return false;
-  } else {
-    return false;
-  }
-  const Eigen::Vector3d p1 = v1.T * X, p2 = v2.T * X;
-  if (p1.z() <= 0 || p2.z() <= 0) return false;
-  if (!reprojectionOk(cam, pyr, p1, k1, ur1, stereo1) || !reprojectionOk(cam, pyr, p2, k2, ur2, stereo2))
-    return false;
-  const double d1 = (X - v1.O).norm(), d2 = (X - v2.O).norm();
-  if (d1 == 0 || d2 == 0) return false;
-  const double ratio_factor = kScaleConsistency * pyr.scale_factor;
-  const double ratio_dist = d2 / d1;
-  const double ratio_oct = pyr.scale[k1.octave] / pyr.scale[k2.octave];
-  return !(ratio_dist * ratio_factor < ratio_oct || ratio_dist > ratio_oct * ratio_factor);
-}
-
-}  // namespace
-
 void LocalMapping::createNewMapPoints(std::unique_lock<std::mutex>& map_lock) {
   const KeyFramePtr& kf1 = current_;
   const std::vector<KeyFramePtr> neigh = kf1->bestCovisibles(opt_.triangulation_neighbours);
-  const View v1 = viewOf(*kf1);
+  const TriangulationView v1(*kf1);
   const Eigen::Matrix3d K = (Eigen::Matrix3d() << cam_.fx, 0, cam_.cx, 0, cam_.fy, cam_.cy, 0, 0, 1).finished();
   const Eigen::Matrix3d Kinv = K.inverse();
   for (const KeyFramePtr& kf2 : neigh) {
     if (kf2 != neigh.front()) map_.yieldToTracking(map_lock);
     if (kf2->bad || current_->bad) continue;
     if (!queueEmpty(queue_mutex_, queue_) && kf2 != neigh.front()) break;
-    const View v2 = viewOf(*kf2);
+    const TriangulationView v2(*kf2);
     if ((v2.O - v1.O).norm() < cam_.baseline()) continue;
     const Pose T21 = v2.T * v1.T.inverse();
     const Eigen::Matrix3d F21 = Kinv.transpose() * skew(T21.translation()) * T21.linear() * Kinv;
     for (const auto& m : matcher::searchForTriangulation(*kf1, *kf2, F21)) {
       Eigen::Vector3d X;
-      if (!triangulateMatch(cam_, v1, v2, m.first, m.second, Kinv, X)) continue;
+      if (!triangulateMatch(cam_, v1, v2, m.first, m.second, opt_.free_space_ratio, X)) continue;
       auto mp = std::make_shared<MapPoint>(map_.newPointId(), X, kf1.get(), kf1->frame_id);
       Map::addObservation(mp, kf1, m.first);
       Map::addObservation(mp, kf2, m.second);

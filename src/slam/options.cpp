@@ -46,6 +46,7 @@ const OptionTable<LocalMappingOptions>& mappingFields() {
       {"LocalMapping.triangulationNeighbours", &O::triangulation_neighbours, Range::atLeast(1)},
       {"LocalMapping.fuseNeighbours", &O::fuse_neighbours, Range::atLeast(1)},
       {"LocalMapping.cullingRedundancy", &O::culling_redundancy, Range::closed(0, 1)},
+      {"LocalMapping.freeSpaceRatio", &O::free_space_ratio, Range::closed(0, 1)},
       {"LocalMapping.localBA", &O::local_ba},
       {"LocalMapping.queueSize", &O::queue_size, Range::atLeast(1)},
       {"LocalMapping.threadNice", &O::thread_nice, Range::closed(0, 19)},

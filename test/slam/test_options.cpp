@@ -136,6 +136,7 @@ Tracking.localMapFromPrediction: 0
 LocalMapping.triangulationNeighbours: 12
 LocalMapping.fuseNeighbours: 8
 LocalMapping.cullingRedundancy: 0.875
+LocalMapping.freeSpaceRatio: 0.25
 LocalMapping.localBA: 0
 LocalMapping.queueSize: 4
 LocalMapping.threadNice: 3
@@ -292,8 +293,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
-                     p.thread_nice),
-            std::make_tuple(12, 8, 0.875, false, 4, 3));
+                     p.thread_nice, p.free_space_ratio),
+            std::make_tuple(12, 8, 0.875, false, 4, 3, 0.25));
   const slam::LoopClosingOptions& l = sys.slam.loop;
   EXPECT_EQ(std::tie(l.enabled, l.min_score, l.consistency, l.min_keyframes, l.min_bow_matches),
             std::make_tuple(false, 0.0625, 4, 12, 25));

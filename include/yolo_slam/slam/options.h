@@ -66,6 +66,9 @@ struct LocalMappingOptions {
   int fuse_neighbours = 10;           // LocalMapping.fuseNeighbours
   double culling_redundancy = 0.9;    // LocalMapping.cullingRedundancy: keyframe culled if this share
                                       // of its points is seen by >= 3 other keyframes
+  double free_space_ratio = 0.5;      // LocalMapping.freeSpaceRatio: a point triangulated for a
+                                      // keypoint without depth nearer than this share of the
+                                      // depth measured around it is refused (0: off, ORB-SLAM2)
   bool local_ba = true;               // LocalMapping.localBA
   int queue_size = 3;                 // LocalMapping.queueSize: bounded keyframe queue
   int thread_nice = 10;               // LocalMapping.threadNice: the local BA's solve runs on a
