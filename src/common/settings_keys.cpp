@@ -197,6 +197,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.voPoints",
       "Tracking.youngLostResetFrames",
       "Tracking.youngMapFrames",
+      "Tracking.youngPointCheck",
   };
   return keys;
 }

@@ -512,6 +512,16 @@ float iou(const cv::Rect2f& a, const cv::Rect2f& b) {
   return uni > 0 ? inter / uni : 0.f;
 }
 
+// Median depth of keypoints with depth (+infinity for none).
+float medianDepth(const features::FeatureFrame& frame, const std::vector<int>& idx) {
+  std::vector<float> d;
+  d.reserve(idx.size());
+  for (int i : idx) d.push_back(frame.depth[i]);
+  if (d.empty()) return std::numeric_limits<float>::infinity();
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
 // Share of a person set that another region claimed as its own person, above which the set is
 // taken to be that region's person seen through this box.
 constexpr double kClaimedShare = 0.5;
@@ -538,10 +548,17 @@ void resolveOcclusions(const Screener& s, const features::FeatureFrame& frame, c
                             std::back_inserter(shared));
       if (shared.size() < kClaimedShare * sets[b].size()) continue;
       Region& r = regions[b];
+      const Region before = r;
       r.idx.erase(std::remove_if(r.idx.begin(), r.idx.end(),
                                  [&](int i) { return std::binary_search(sets[c].begin(), sets[c].end(), i); }),
                   r.idx.end());
       st.iterations += findPerson(s, frame, r);
+      // The person behind an occluder is deeper than it. A nearer set means the shared
+      // keypoints were two people side by side at one depth, and the first set was right.
+      if (medianDepth(frame, personSet(r)) < medianDepth(frame, shared)) {
+        r = before;
+        continue;
+      }
       ++st.occluded_boxes;
       break;
     }

@@ -36,6 +36,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.maxJumpInliers", &O::max_jump_inliers, Range::atLeast(0)},
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
       {"Tracking.localMapFromPrediction", &O::local_map_from_prediction},
+      {"Tracking.youngPointCheck", &O::young_point_check},
   };
   return table;
 }

@@ -8,6 +8,7 @@
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
 #include "yolo_slam/slam/observation.h"
+#include "yolo_slam/slam/young_points.h"
 #include "yolo_slam/vocabulary/keyframe_database.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
@@ -311,6 +312,7 @@ bool Tracking::initialize(Frame& F) {
   ref_kf_ = kf;
   last_kf_frame_id_ = F.id;
   init_frame_id_ = F.id;
+  init_kf_id_ = kf->id;
   local_kfs_ = {kf};
   local_points_ = kf->mapPoints();
   has_velocity_ = false;
@@ -638,6 +640,7 @@ bool Tracking::trackLocalMap(Frame& F) {
   updateLocalMap(F);
   searchLocalPoints(F);
   optimizePose(F);
+  if (opt_.young_point_check && dropDisagreeingYoungPoints(F) > 0) optimizePose(F);
   inliers_ = 0;
   for (int i = 0; i < F.N; ++i) {
     const MapPointPtr& mp = F.points[i];
@@ -651,6 +654,14 @@ bool Tracking::trackLocalMap(Frame& F) {
     }
   }
   return inliers_ >= opt_.min_inliers;
+}
+
+int Tracking::dropDisagreeingYoungPoints(Frame& F) {
+  const long last_kf_id = last_kf_ ? last_kf_->id : -1;
+  const int released = releaseDisagreeingYoung(
+      cam_, F, [&](const MapPoint& mp) { return isYoung(mp, last_kf_id, init_kf_id_); }, prior_ ? &*prior_ : nullptr);
+  young_dropped_ += released;
+  return released;
 }
 
 bool Tracking::needNewKeyFrame(const Frame& F) const {
@@ -763,6 +774,7 @@ void Tracking::resetKeepTrajectory() {
   last_ref_.reset();
   last_kf_frame_id_ = -1;
   init_frame_id_ = -1;
+  init_kf_id_ = -1;
   last_tracked_id_ = -1;
   has_velocity_ = false;
   failures_in_row_ = 0;

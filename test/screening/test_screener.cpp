@@ -634,6 +634,42 @@ TEST(OcclusionRule, FindsThePersonBehindAnotherOne) {
   EXPECT_LE(on[0], off[0] + 2);  // and not the wall
 }
 
+TEST(OcclusionRule, KeepsTwoPeopleSideBySideAtOneDepth) {
+  // A and B walk side by side at 2 m; B's box holds more of A than of B, so B's set is mostly
+  // A's. Screened again without A, B's box would find the arm of C (1.2 m) reaching into it and
+  // leave B static: a nearer set than the one removed is no person behind, the first set stays.
+  features::FeatureFrame f;
+  f.width = 640;
+  f.height = 480;
+  std::vector<int> who;  // 0 wall, 1 A, 2 B, 3 C
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  auto add = [&](float x, float y, float d, int id) {
+    f.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
+    f.depth.push_back(d);
+    who.push_back(id);
+  };
+  for (int i = 0; i < 160; ++i) add(200 + 130 * u(rng), 60 + 400 * u(rng), 1.95f + 0.1f * u(rng), 1);
+  for (int i = 0; i < 40; ++i) add(332 + 66 * u(rng), 60 + 400 * u(rng), 2.0f + 0.1f * u(rng), 2);
+  for (int i = 0; i < 100; ++i) add(400 + 160 * u(rng), 40 + 430 * u(rng), 1.15f + 0.1f * u(rng), 3);
+  for (int i = 0; i < 60; ++i) add(20 + 160 * u(rng), 480 * u(rng), 3.9f + 0.2f * u(rng), 0);
+  f.keypoints_un = f.keypoints;
+  detection::Boxes boxes(3);
+  boxes[0].rect = cv::Rect2f(195, 50, 140, 420);  // A
+  boxes[1].rect = cv::Rect2f(260, 50, 180, 420);  // B, holding A's right half and C's arm
+  boxes[2].rect = cv::Rect2f(395, 30, 170, 445);  // C
+  for (auto& b : boxes) b.score = 0.9f;
+  ScreeningOptions o;
+  o.box_dilation = 0;
+  Screener(o).screen(f, boxes);
+  int dropped[4] = {0, 0, 0, 0};
+  for (size_t i = 0; i < f.size(); ++i) dropped[who[i]] += f.dynamic[i];
+  EXPECT_EQ(dropped[1], 160);
+  EXPECT_GE(dropped[2], 38);  // B, at A's depth, found with A
+  EXPECT_EQ(dropped[3], 100);
+  EXPECT_EQ(dropped[0], 0);
+}
+
 TEST(OcclusionRule, LeavesADuplicateDetectionAlone) {
   // Two boxes around one person (two models, or a carried box next to a detection) overlap by
   // far more than occlusionMaxIou: the second is not screened again, the wall stays.

@@ -69,6 +69,7 @@ struct SystemStats {
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   size_t jumps_refused = 0;  // poses refused as a jump from the motion model (Tracking.maxJump)
   size_t tracked_from_prediction = 0;  // frames tracked from the prediction (Tracking.localMapFromPrediction)
+  size_t young_points_dropped = 0;     // matches released by Tracking.youngPointCheck
   // Frames not tracked because no map may start before the first detection (counted as lost).
   size_t awaiting_detection = 0;
   screening::ScreeningStats keypoints;  // Screener::screen
@@ -87,7 +88,7 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 
 // The counts of stats.json, shared by System::statsJson and yolo_slam_run: frames, tracked,
 // lost, keyframes, keyframes_culled, map_points, map_resets, relocalizations, jumps_refused,
-// tracked_from_prediction, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
+// tracked_from_prediction, young_points_dropped, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
 // {...}, boxes_screened {...},
 // feature_budget_mean (nFeatures multiples extracted, mean over the frames).
 Json statsCountsJson(const SystemStats& s);

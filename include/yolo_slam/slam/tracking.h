@@ -71,6 +71,8 @@ class Tracking {
   size_t jumpsRefused() const { return jumps_refused_; }
   // Frames tracked from the motion model's prediction alone (Tracking.localMapFromPrediction).
   size_t trackedFromPrediction() const { return from_prediction_; }
+  // Matches of once-seen map points released by Tracking.youngPointCheck.
+  size_t youngPointsDropped() const { return young_dropped_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -114,6 +116,9 @@ class Tracking {
   // PnP RANSAC on F's associations; sets the pose and keeps the inliers' associations.
   bool pnpPose(Frame& F) const;
   bool trackLocalMap(Frame& F);
+  // Tracking.youngPointCheck (young_points.h): releases the matches of young points that
+  // disagree with the pose of the confirmed points alone; returns how many.
+  int dropDisagreeingYoungPoints(Frame& F);
   // Re-anchors the last frame on its (possibly refined or erased) reference keyframe.
   void updateLastFrame();
   // Localization mode: temporary close points in the last frame for visual odometry.
@@ -175,6 +180,8 @@ class Tracking {
   std::optional<optimization::PosePrior> prior_;
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
   size_t from_prediction_ = 0;
+  size_t young_dropped_ = 0;
+  long init_kf_id_ = -1;  // the first keyframe of the map being built (-1: a loaded map)  // matches released by the young-point check
 };
 
 }  // namespace slam
