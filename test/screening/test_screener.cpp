@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <random>
@@ -589,42 +590,75 @@ TEST(Screener, DepthProbeKeepsHolesOfTheBackground) {
   EXPECT_EQ(ScreeningOptions::load(Config::fromString("Screening.noDepthProbeRadius: 6\n", "s.yaml")).no_depth_probe_radius_px, 6.0);
 }
 
+namespace {
+
+// Keypoints with depth scattered over rectangles, each labelled with whose it is (0: the wall).
+struct Crowd {
+  features::FeatureFrame f;
+  std::vector<int> who;
+  std::mt19937 rng;
+  std::uniform_real_distribution<float> u{0.f, 1.f};
+
+  explicit Crowd(unsigned seed) : rng(seed) {
+    f.width = 640;
+    f.height = 480;
+  }
+  float uniform() { return u(rng); }
+  void add(float x, float y, float d, int id) {
+    f.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
+    f.depth.push_back(d);
+    who.push_back(id);
+  }
+  // n keypoints uniform in x0 + [0, w), y0 + [0, h), depth d0 + [0, dd).
+  void scatter(int n, float x0, float w, float y0, float h, float d0, float dd, int id) {
+    for (int i = 0; i < n; ++i) add(x0 + w * uniform(), y0 + h * uniform(), d0 + dd * uniform(), id);
+  }
+  // Screens a copy of the frame; the dropped keypoints per label.
+  std::vector<int> dropped(const ScreeningOptions& o, const detection::Boxes& boxes, ScreeningStats* st = nullptr) const {
+    features::FeatureFrame g = f;
+    g.keypoints_un = g.keypoints;
+    const ScreeningStats s = Screener(o).screen(g, boxes);
+    if (st) *st = s;
+    std::vector<int> n(*std::max_element(who.begin(), who.end()) + 1, 0);
+    for (size_t i = 0; i < g.size(); ++i) n[who[i]] += g.dynamic[i];
+    return n;
+  }
+};
+
+detection::Boxes boxesAt(std::initializer_list<cv::Rect2f> rects) {
+  detection::Boxes boxes;
+  for (const cv::Rect2f& r : rects) {
+    detection::Box b;
+    b.rect = r;
+    b.score = 0.9f;
+    boxes.push_back(b);
+  }
+  return boxes;
+}
+
+}  // namespace
+
 TEST(OcclusionRule, FindsThePersonBehindAnotherOne) {
   // Person A at 1.5 m, x in [300, 400); person B at 2.5 m behind and to the left, x in
   // [200, 340): A covers B's right part. The wall at 4 m. B's box holds A's left part,
   // which is B's box's nearest sizeable cluster, so without the rule B is never found.
-  features::FeatureFrame f;
-  f.width = 640;
-  f.height = 480;
-  std::vector<int> who;  // 0 wall, 1 A, 2 B
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  auto add = [&](float x, float y, float d, int id) {
-    f.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
-    f.depth.push_back(d);
-    who.push_back(id);
-  };
-  for (int i = 0; i < 120; ++i) add(300 + 100 * u(rng), 60 + 400 * u(rng), 1.4f + 0.2f * u(rng), 1);
-  for (int i = 0; i < 50; ++i) add(200 + 100 * u(rng), 80 + 380 * u(rng), 2.4f + 0.2f * u(rng), 2);
+  Crowd c(5);
+  c.scatter(120, 300, 100, 60, 400, 1.4f, 0.2f, 1);
+  c.scatter(50, 200, 100, 80, 380, 2.4f, 0.2f, 2);
   for (int i = 0; i < 120; ++i) {
-    const float x = u(rng) < 0.5f ? 100 + 95 * u(rng) : 405 + 200 * u(rng);
-    add(x, 480 * u(rng), 3.9f + 0.2f * u(rng), 0);
+    const float x = c.uniform() < 0.5f ? 100 + 95 * c.uniform() : 405 + 200 * c.uniform();
+    c.add(x, 480 * c.uniform(), 3.9f + 0.2f * c.uniform(), 0);
   }
-  f.keypoints_un = f.keypoints;
-  detection::Boxes boxes(2);
-  boxes[0].rect = cv::Rect2f(295, 50, 110, 420);  // A
-  boxes[1].rect = cv::Rect2f(195, 70, 200, 400);  // B, overlapping A's left part
-  for (auto& b : boxes) b.score = 0.9f;
+  // A, then B overlapping A's left part.
+  const detection::Boxes boxes = boxesAt({cv::Rect2f(295, 50, 110, 420), cv::Rect2f(195, 70, 200, 400)});
   auto droppedOf = [&](bool rule) {
     ScreeningOptions o;
     o.occlusion_rule = rule;
     o.box_dilation = 0;
-    features::FeatureFrame g = f;
-    const ScreeningStats st = Screener(o).screen(g, boxes);
-    int dropped[3] = {0, 0, 0};
-    for (size_t i = 0; i < g.size(); ++i) dropped[who[i]] += g.dynamic[i];
+    ScreeningStats st;
+    const std::vector<int> d = c.dropped(o, boxes, &st);
     EXPECT_EQ(st.occluded_boxes, rule ? 1 : 0);
-    return std::vector<int>(dropped, dropped + 3);
+    return d;
   };
   const std::vector<int> off = droppedOf(false), on = droppedOf(true);
   EXPECT_EQ(off[1], 120);
@@ -638,32 +672,17 @@ TEST(OcclusionRule, KeepsTwoPeopleSideBySideAtOneDepth) {
   // A and B walk side by side at 2 m; B's box holds more of A than of B, so B's set is mostly
   // A's. Screened again without A, B's box would find the arm of C (1.2 m) reaching into it and
   // leave B static: a nearer set than the one removed is no person behind, the first set stays.
-  features::FeatureFrame f;
-  f.width = 640;
-  f.height = 480;
-  std::vector<int> who;  // 0 wall, 1 A, 2 B, 3 C
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  auto add = [&](float x, float y, float d, int id) {
-    f.keypoints.emplace_back(cv::Point2f(x, y), 31.f);
-    f.depth.push_back(d);
-    who.push_back(id);
-  };
-  for (int i = 0; i < 160; ++i) add(200 + 130 * u(rng), 60 + 400 * u(rng), 1.95f + 0.1f * u(rng), 1);
-  for (int i = 0; i < 40; ++i) add(332 + 66 * u(rng), 60 + 400 * u(rng), 2.0f + 0.1f * u(rng), 2);
-  for (int i = 0; i < 100; ++i) add(400 + 160 * u(rng), 40 + 430 * u(rng), 1.15f + 0.1f * u(rng), 3);
-  for (int i = 0; i < 60; ++i) add(20 + 160 * u(rng), 480 * u(rng), 3.9f + 0.2f * u(rng), 0);
-  f.keypoints_un = f.keypoints;
-  detection::Boxes boxes(3);
-  boxes[0].rect = cv::Rect2f(195, 50, 140, 420);  // A
-  boxes[1].rect = cv::Rect2f(260, 50, 180, 420);  // B, holding A's right half and C's arm
-  boxes[2].rect = cv::Rect2f(395, 30, 170, 445);  // C
-  for (auto& b : boxes) b.score = 0.9f;
+  Crowd c(11);
+  c.scatter(160, 200, 130, 60, 400, 1.95f, 0.1f, 1);
+  c.scatter(40, 332, 66, 60, 400, 2.0f, 0.1f, 2);
+  c.scatter(100, 400, 160, 40, 430, 1.15f, 0.1f, 3);
+  c.scatter(60, 20, 160, 0, 480, 3.9f, 0.2f, 0);
+  // A; B, holding A's right half and C's arm; C.
+  const detection::Boxes boxes =
+      boxesAt({cv::Rect2f(195, 50, 140, 420), cv::Rect2f(260, 50, 180, 420), cv::Rect2f(395, 30, 170, 445)});
   ScreeningOptions o;
   o.box_dilation = 0;
-  Screener(o).screen(f, boxes);
-  int dropped[4] = {0, 0, 0, 0};
-  for (size_t i = 0; i < f.size(); ++i) dropped[who[i]] += f.dynamic[i];
+  const std::vector<int> dropped = c.dropped(o, boxes);
   EXPECT_EQ(dropped[1], 160);
   EXPECT_GE(dropped[2], 38);  // B, at A's depth, found with A
   EXPECT_EQ(dropped[3], 100);
