@@ -22,8 +22,9 @@
 #   :every / :async   detection on every frame before it is screened (the paper's pipeline,
 #             the default of yolo_slam_run) / asynchronous detection (the ROS launch files' default)
 #   :seq      the deterministic mode (--sequential): one run is all runs
-#   :orbkf    ORB-SLAM2's keyframe rules (Tracking.closeMinFrames=0, Tracking.keyFramePoints=100):
-#             "off:orbkf" is ORB-SLAM2 itself; plain "off" is this SLAM without screening
+#   :orbkf    ORB-SLAM2's keyframe rules (Tracking.closeMinFrames=0, Tracking.keyFramePoints=100)
+#   :noyoung  no young-point check (--set Tracking.youngPointCheck=0): "off:orbkf:noyoung" is
+#             the nearest to ORB-SLAM2; plain "off" is this SLAM without screening
 #   :camera   frames fed at 30 Hz as a live camera, dropped while busy (--camera-rate)
 # ":notrack:noveto:noprop:single" is the paper's method as printed.
 # Each preset is generated once (fixed seed; reused when the same preset/frames/seed exists in
@@ -96,6 +97,7 @@ suffix_options() {
       async) extra+=(--detection async) ;;
       seq) extra+=(--sequential) ;;
       orbkf) extra+=(--set Tracking.closeMinFrames=0 --set Tracking.keyFramePoints=100) ;;
+      noyoung) extra+=(--set Tracking.youngPointCheck=0) ;;
       camera) extra+=(--camera-rate) ;;
       *) return 1 ;;
     esac
@@ -107,7 +109,7 @@ for m in $modes; do
     off|detect|geometry|detect+geometry) ;;
     *) echo "error: unknown mode '$m' in --modes; use off, detect, geometry, detect+geometry" >&2; exit 1 ;;
   esac
-  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :motion :nomotion :nobeyond :single :every :async :seq :orbkf :camera" >&2; exit 1; }
+  suffix_options "$m" || { echo "error: unknown suffix in mode '$m'; use :gt :notrack :veto :noveto :prop :noprop :motion :nomotion :nobeyond :single :every :async :seq :orbkf :noyoung :camera" >&2; exit 1; }
 done
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3

@@ -184,7 +184,7 @@ def main():
 
     suffix_names = {"gt": "GT boxes", "notrack": "no box tracking", "veto": "static-box veto",
                     "noveto": "no static-box veto", "prop": "label propagation",
-                    "noprop": "no label propagation"}
+                    "noprop": "no label propagation", "noyoung": "no young-point check"}
 
     def label(m):
         base, *sfx = m.split(":")
