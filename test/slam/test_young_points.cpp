@@ -31,6 +31,7 @@ const CameraModel& camera() {
 // One frame at the origin looking along +z: keypoint i observes points[i] (where a point moved
 // by `moved` would project), with the point's depth as its measured depth.
 struct Scene {
+  std::shared_ptr<Map> map;  // owns the keyframes and points, and breaks their cycles at the end
   Frame F;
   KeyFramePtr kf;
   std::set<long> young_ids;
@@ -78,10 +79,13 @@ Scene makeScene(const std::vector<Spot>& spots) {
   Scene scene;
   scene.F = Frame(ff, cam, FrameGeometry::make(cam), pyr, 10);
   scene.F.setPose(Pose::Identity());
+  scene.map = std::make_shared<Map>();
   scene.kf = std::make_shared<KeyFrame>(1, scene.F);
+  scene.map->addKeyFrame(scene.kf);
   for (size_t i = 0; i < spots.size(); ++i) {
     auto mp = std::make_shared<MapPoint>(static_cast<long>(i), spots[i].X, scene.kf.get(), 5);
     Map::addObservation(mp, scene.kf, i);
+    scene.map->addMapPoint(mp);
     scene.F.points[i] = mp;
     if (spots[i].young) scene.young_ids.insert(mp->id);
     if (spots[i].person) scene.person.insert(static_cast<int>(i));
@@ -137,6 +141,7 @@ TEST(YoungPoints, IsYoungFollowsTheKeyFramesThatSawThePoint) {
   EXPECT_TRUE(isYoung(mp, 9, 0));
   EXPECT_FALSE(isYoung(mp, 9, 1)) << "the map's first keyframe's points are the reference";
   auto kf2 = std::make_shared<KeyFrame>(2, s.F);
+  s.map->addKeyFrame(kf2);
   Map::addObservation(s.F.points[0], kf2, 0);
   EXPECT_TRUE(isYoung(mp, 1 + kYoungKeyFrames, 0)) << "seen twice but made within the last keyframes";
   EXPECT_FALSE(isYoung(mp, 2 + kYoungKeyFrames, 0));
