@@ -57,10 +57,10 @@ struct TrackingOptions {
   // local-map step, min_inliers as always). A person crossing close to the camera hides what
   // the last frame and the reference keyframe saw, while the local map holds the room behind.
   bool local_map_from_prediction = true;  // Tracking.localMapFromPrediction
-  // Beyond ORB-SLAM2: map points seen by one keyframe only (just made from depth) must agree
-  // with the pose the confirmed points give alone, or they are not matched in this frame. A
-  // person the screening missed when a keyframe was made is otherwise in the map at once, and
-  // the next frames' poses follow the person.
+  // Beyond ORB-SLAM2: young map points (made by one of the last keyframes, or seen by one
+  // keyframe only; young_points.h) must agree with the pose the confirmed points give alone, or
+  // they are not matched in this frame. A person the screening missed when a keyframe was made
+  // is otherwise in the map at once, and the next frames' poses follow the person.
   bool young_point_check = true;  // Tracking.youngPointCheck
 
   static TrackingOptions load(const Config& cfg);

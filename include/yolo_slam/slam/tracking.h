@@ -180,8 +180,8 @@ class Tracking {
   std::optional<optimization::PosePrior> prior_;
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
   size_t from_prediction_ = 0;
-  size_t young_dropped_ = 0;
-  long init_kf_id_ = -1;  // the first keyframe of the map being built (-1: a loaded map)  // matches released by the young-point check
+  size_t young_dropped_ = 0;  // matches released by the young-point check
+  long init_kf_id_ = -1;      // the first keyframe of the map being built (-1: a loaded map)
 };
 
 }  // namespace slam
