@@ -149,6 +149,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Screening.trackMinMatches",
       "Screening.trackMinScore",
       "Screening.trackShiftStale",
+      "Screening.trackNearFraction",
       "Screening.trackRadius",
       "Screening.varianceThreshold",
       "Screening.variant",

@@ -12,6 +12,16 @@
 namespace yolo_slam {
 namespace screening {
 
+namespace {
+constexpr float kNearPersonHeight = 0.9f;  // share of the image's height (isNearPersonBox)
+}  // namespace
+
+bool isNearPersonBox(const cv::Rect2f& box, int width, int height, double near_fraction) {
+  const double image_area = static_cast<double>(width) * height;
+  return image_area > 0 && near_fraction < 1 && box.area() >= near_fraction * image_area &&
+         box.height >= kNearPersonHeight * height;
+}
+
 double iou(const cv::Rect2f& a, const cv::Rect2f& b) {
   const float inter = (a & b).area();
   const float uni = a.area() + b.area() - inter;
@@ -30,6 +40,7 @@ const OptionTable<BoxTrackerOptions>& trackerFields() {
       {"Screening.trackMinMatches", &O::min_matches, Range::atLeast(1)},
       {"Screening.trackMinScore", &O::min_score, Range::closed(0, 1)},
       {"Screening.trackShiftStale", &O::shift_stale},
+      {"Screening.trackNearFraction", &O::near_fraction, Range::fraction()},
   };
   return table;
 }
@@ -140,10 +151,12 @@ bool BoxTracker::carry(Track& tr, const features::FeatureFrame& frame, const det
                        bool detector_ran) const {
   // A weak track is dropped when the detector looked and did not find it again; a frame the
   // detector never saw (asynchronous detection) carries every track.
-  if (++tr.age > opt_.max_age || (detector_ran && tr.box.score < opt_.min_score)) return false;
-  if (!tr.moved_now) return false;
-  const cv::Point2f d = *tr.moved_now;
   const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
+  const bool near =
+      isNearPersonBox(tr.box.rect, frame.width, frame.height, opt_.near_fraction) && tr.best_score >= opt_.min_score;
+  if (++tr.age > opt_.max_age || (detector_ran && !near && tr.box.score < opt_.min_score)) return false;
+  if (!tr.moved_now && !near) return false;
+  const cv::Point2f d = tr.moved_now.value_or(cv::Point2f(0.f, 0.f));
   cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);
   const cv::Rect2f visible = frame.width > 0 && frame.height > 0 ? (moved & image) : moved;
   // Mostly outside the image: the person walked out of view.
@@ -185,6 +198,7 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
     if (track_det[t] >= 0) {
       det_used[track_det[t]] = true;
       tr.box = out[track_det[t]];
+      tr.best_score = std::max(tr.best_score, tr.box.score);
       tr.age = 0;
       kept.push_back(std::move(tr));
     } else if (carry(tr, frame, placed, detector_ran)) {
@@ -197,6 +211,7 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
     Track tr;
     tr.id = next_id_++;
     tr.box = out[j];
+    tr.best_score = tr.box.score;
     kept.push_back(std::move(tr));
   }
   std::sort(kept.begin(), kept.end(), [](const Track& a, const Track& b) { return a.id < b.id; });

@@ -249,6 +249,66 @@ TEST(BoxTracker, LowScoreDetectionNotCarried) {
   EXPECT_EQ(tr2.predict(makeFrame(s, 5, 0), {}).size(), 1u);
 }
 
+// A person filling most of the view: the detector was sure of them, then scored them low, then
+// finds nothing, and their keypoints no longer match (here: gone from the frame). The box is
+// held where it was, for max_age frames. It is dropped at once with trackNearFraction 1, when
+// it is small, and when the detector never scored it at least trackMinScore.
+TEST(BoxTracker, NearPersonHeldWhileUnmatched) {
+  const cv::Rect2f near_box(100, 20, 440, 450);  // 64 % of the image
+  Scene s = makeScene(near_box, 60, 100, 12);
+  detection::Box sure = personBox(near_box), weak = personBox(near_box);
+  weak.score = 0.35f;
+  auto start = [&](BoxTracker& tr, const detection::Boxes& first) {
+    for (const detection::Boxes& d : {first, detection::Boxes{weak}}) {
+      features::FeatureFrame f = makeFrame(s, 0, 0);
+      tr.predict(f, d);
+      tr.observe(f);
+    }
+  };
+  BoxTrackerOptions o;
+  ASSERT_LE(o.near_fraction, 0.6);
+  BoxTracker tr(o);
+  start(tr, {sure});
+  for (int k = 1; k <= o.max_age; ++k) {
+    features::FeatureFrame f = makeFrame(s, 0, 0, false);
+    detection::Boxes b = tr.predict(f, {});
+    ASSERT_EQ(b.size(), 1u) << "frame " << k;
+    EXPECT_TRUE(b[0].tracked);
+    EXPECT_EQ(b[0].rect, near_box);
+    tr.observe(f);
+  }
+  EXPECT_TRUE(tr.predict(makeFrame(s, 0, 0, false), {}).empty());
+
+  BoxTracker never_sure(o);
+  start(never_sure, {weak});
+  EXPECT_TRUE(never_sure.predict(makeFrame(s, 0, 0, false), {}).empty());
+  o.near_fraction = 1.0;
+  BoxTracker off(o);
+  start(off, {sure});
+  EXPECT_TRUE(off.predict(makeFrame(s, 0, 0, false), {}).empty());
+  // A small box, sure then weak: dropped as before.
+  Scene small = makeScene(kBox, 40, 100, 13);
+  detection::Box weak_small = personBox(kBox);
+  weak_small.score = 0.35f;
+  BoxTracker tr_small(BoxTrackerOptions{});
+  for (const detection::Box& d : {personBox(kBox), weak_small}) {
+    features::FeatureFrame f = makeFrame(small, 0, 0);
+    tr_small.predict(f, {d});
+    tr_small.observe(f);
+  }
+  EXPECT_TRUE(tr_small.predict(makeFrame(small, 0, 0, false), {}).empty());
+}
+
+TEST(BoxTracker, NearPersonBoxIsLargeAndTall) {
+  EXPECT_TRUE(screening::isNearPersonBox(cv::Rect2f(100, 20, 440, 450), 640, 480, 0.4));
+  // Wide over a rolled view but short: not a person at the lens.
+  EXPECT_FALSE(screening::isNearPersonBox(cv::Rect2f(10, 10, 600, 350), 640, 480, 0.4));
+  EXPECT_FALSE(screening::isNearPersonBox(cv::Rect2f(200, 0, 120, 480), 640, 480, 0.4));  // small
+  // trackNearFraction 1 turns the rule off, even for a box over the whole image.
+  EXPECT_FALSE(screening::isNearPersonBox(cv::Rect2f(0, 0, 640, 480), 640, 480, 1.0));
+  EXPECT_FALSE(screening::isNearPersonBox(cv::Rect2f(0, 0, 640, 480), 0, 0, 0.4));  // no image size
+}
+
 // Asynchronous detection: a detection of the image two frames back arrives while the person
 // walks 6 px a frame. It is moved by the person's keypoint travel since that image.
 TEST(BoxTracker, StaleDetectionMovedByTheTravelSinceItsImage) {
@@ -300,6 +360,9 @@ TEST(BoxTracker, OptionsValidated) {
   EXPECT_THROW(BoxTracker{o}, Error);
   o = BoxTrackerOptions{};
   o.radius_px = -1;
+  EXPECT_THROW(BoxTracker{o}, Error);
+  o = BoxTrackerOptions{};
+  o.near_fraction = 1.5;
   EXPECT_THROW(BoxTracker{o}, Error);
   // Every key's value: test/slam/test_options.cpp.
   Config bad = Config::fromString("%YAML:1.0\nScreening.trackMaxAge: 0\n", "bad.yaml");

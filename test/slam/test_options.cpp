@@ -92,6 +92,7 @@ Screening.trackMaxHamming: 45
 Screening.trackMinMatches: 6
 Screening.trackMinScore: 0.625
 Screening.trackShiftStale: 0
+Screening.trackNearFraction: 0.625
 Screening.staticBoxVeto: 0
 Screening.staticBoxMaxScore: 0.75
 Screening.staticBoxFraction: 0.625
@@ -269,6 +270,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   const screening::BoxTrackerOptions& t = s.tracker;
   EXPECT_EQ(std::tie(t.enabled, t.max_age, t.radius_px, t.max_hamming, t.min_matches, t.min_score, t.shift_stale),
             std::make_tuple(false, 4, 35.5, 45, 6, 0.625, false));
+  EXPECT_EQ(t.near_fraction, 0.625);
   const screening::TemporalOptions& m = s.temporal;
   EXPECT_EQ(std::tie(m.static_box_veto, m.static_box_max_score, m.static_box_fraction, m.static_box_min_points),
             std::make_tuple(false, 0.75, 0.625, 12));

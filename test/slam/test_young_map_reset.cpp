@@ -70,7 +70,7 @@ TEST(SlamYoungMapReset, YoungMapLostIsResetAndTrackingGoesOn) {
 }
 
 TEST(SlamYoungMapReset, OlderMapsAndShortLossesAreKept) {
-  EXPECT_EQ(slam::TrackingOptions{}.young_lost_reset_frames, 5);
+  EXPECT_EQ(slam::TrackingOptions{}.young_lost_reset_frames, 10);
   EXPECT_EQ(runWithBlanks(10, 4, 0).resets, 0u);   // the rule off
   EXPECT_EQ(runWithBlanks(40, 4, 3).resets, 0u);   // lost 40 frames after initialisation: not young
   EXPECT_EQ(runWithBlanks(10, 2, 3).resets, 0u);   // fewer lost frames than the rule waits for

@@ -56,9 +56,17 @@ struct BoxTrackerOptions {
   // detection of a track is moved by how far the track moved since that image: its box centre
   // then to now, summed from its keypoints' displacements frame by frame.
   bool shift_stale = true;
+  // A track whose box covers at least this share of the image, and nine tenths of its height,
+  // is a person near the camera. As a person comes to fill the view the detector's score falls
+  // (0.3-0.5) and then it finds nothing, and blur and scale change defeat the keypoint matches:
+  // such a track, once detected with at least min_score, is carried whatever its last score,
+  // and where it cannot be matched its box stays where it was (within max_age). Nobody leaves a
+  // view they fill in a frame or two. 1 turns it off.
+  double near_fraction = 0.4;
 
   // Reads Screening.trackBoxes, trackMaxAge (frames), trackRadius (px), trackMaxHamming (bits),
-  // trackMinMatches, trackMinScore, trackShiftStale; throws yolo_slam::Error naming the file and key.
+  // trackMinMatches, trackMinScore, trackShiftStale, trackNearFraction; throws yolo_slam::Error
+  // naming the file and key.
   static BoxTrackerOptions load(const Config& cfg);
   // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
   void validate(const std::string& where = "BoxTrackerOptions") const;
@@ -99,6 +107,7 @@ class BoxTracker {
     long id = 0;
     detection::Box box;              // box used in the current frame
     int age = 0;                     // frames since the last detection
+    float best_score = 0.f;          // the highest score of the track's detections
     std::vector<cv::Point2f> pts;    // remembered dynamic keypoints (image pixels)
     cv::Mat desc;                    // their descriptors, rows match pts
     std::optional<cv::Point2f> moved_now;  // keypoint displacement into the frame in predict()
@@ -129,6 +138,11 @@ class BoxTracker {
 
 // Intersection over union of two boxes (0 when either is empty).
 double iou(const cv::Rect2f& a, const cv::Rect2f& b);
+
+// The box of a person near the camera (BoxTrackerOptions::near_fraction): it covers at least
+// that share of a width x height image and nine tenths of its height (a person near the lens is
+// cut by the image's top and bottom; the detector's wide false boxes over a rolled view are not).
+bool isNearPersonBox(const cv::Rect2f& box, int width, int height, double near_fraction);
 
 }  // namespace screening
 }  // namespace yolo_slam

@@ -33,9 +33,11 @@ struct TrackingOptions {
   // A young map (lost within young_map_frames frames of its initialisation) is reset after
   // young_lost_reset_frames lost frames, whatever its size: a map made while people covered
   // much of the view holds few static points and rarely relocalises (crowd preset, issue 23);
-  // a new one starts at the last good pose. 0 turns it off.
+  // a new one starts at the last good pose, which the camera has left by the lost frames'
+  // motion: a sound young map relocalises once the people move on (crowd seed 7: after 8
+  // frames), so the reset waits a third of a second. 0 turns it off.
   int young_map_frames = 30;        // Tracking.youngMapFrames
-  int young_lost_reset_frames = 5;  // Tracking.youngLostResetFrames
+  int young_lost_reset_frames = 10; // Tracking.youngLostResetFrames
   int vo_points = 100;              // Tracking.voPoints: temporary close points in the last frame
   // Motion prior (beyond ORB-SLAM2): a frame tracked with the motion model is optimised with a
   // Gaussian prior at the constant-velocity prediction, sigma motionPrior metres for the camera
