@@ -193,6 +193,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.motionPrior",
       "Tracking.motionPriorDeg",
       "Tracking.minInliers",
+      "Tracking.relocMinInliers",
       "Tracking.motionWindow",
       "Tracking.refRatio",
       "Tracking.voPoints",

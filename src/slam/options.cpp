@@ -17,6 +17,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.motionWindow", &O::motion_window, Range::atLeast(1)},
       {"Tracking.localWindow", &O::local_window, Range::atLeast(1)},
       {"Tracking.minInliers", &O::min_inliers, Range::atLeast(6)},
+      {"Tracking.relocMinInliers", &O::reloc_min_inliers, Range::atLeast(6)},
       {"Tracking.maxFrames", &O::max_frames_between_kf, Range::atLeast(0)},
       {"Tracking.minFrames", &O::min_frames_between_kf, Range::atLeast(0)},
       {"Tracking.refRatio", &O::ref_ratio, Range::closed(0, 1)},

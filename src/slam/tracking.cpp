@@ -653,7 +653,12 @@ bool Tracking::trackLocalMap(Frame& F) {
       F.points[i].reset();
     }
   }
-  return inliers_ >= opt_.min_inliers;
+  return inliers_ >= minInliers(F);
+}
+
+int Tracking::minInliers(const Frame& F) const {
+  const bool after_reloc = last_reloc_frame_id_ >= 0 && F.id < last_reloc_frame_id_ + max_frames_;
+  return after_reloc ? std::max(opt_.min_inliers, opt_.reloc_min_inliers) : opt_.min_inliers;
 }
 
 int Tracking::dropDisagreeingYoungPoints(Frame& F) {

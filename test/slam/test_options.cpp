@@ -115,6 +115,7 @@ Tracking.initMinDepthPoints: 80
 Tracking.motionWindow: 12
 Tracking.localWindow: 4
 Tracking.minInliers: 25
+Tracking.relocMinInliers: 40
 Tracking.maxFrames: 20
 Tracking.minFrames: 2
 Tracking.refRatio: 0.875
@@ -291,7 +292,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap,
                      k.local_map_from_prediction, k.young_point_check),
             std::make_tuple(120, 4, 80, 0.5, false, false));
-  EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points), std::make_tuple(45, 3, 150));
+  EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points, k.reloc_min_inliers),
+            std::make_tuple(45, 3, 150, 40));
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   const slam::LocalMappingOptions& p = sys.slam.mapping;

@@ -17,6 +17,11 @@ struct TrackingOptions {
   int motion_window = 15;           // Tracking.motionWindow: projection radius (px, level 0) of the motion model
   int local_window = 3;             // Tracking.localWindow: radius factor for the local-map search (RGB-D: 3)
   int min_inliers = 30;             // Tracking.minInliers: below this after local-map tracking the frame fails
+  // Tracking.relocMinInliers: within maxFrames frames of a relocalisation the frame fails below
+  // this many (ORB-SLAM2's TrackLocalMap: 50). A relocalised pose rests on one keyframe's
+  // matches; where people fill most of the view the next frames can follow a person's keypoints
+  // the boxes missed with 30-50 inliers.
+  int reloc_min_inliers = 50;
   int max_frames_between_kf = 0;    // Tracking.maxFrames: 0 = camera fps (ORB-SLAM2)
   int min_frames_between_kf = 0;    // Tracking.minFrames
   double ref_ratio = 0.75;          // Tracking.refRatio: keyframe if tracked < ratio * reference's points

@@ -105,6 +105,8 @@ class Tracking {
   // Tracking.localMapFromPrediction: F starts at `prediction` without associations, so that
   // trackLocalMap searches the last frame's local map from there.
   void startFromPrediction(Frame& F, const Pose& prediction) const;
+  // Inliers the local-map step needs: Tracking.relocMinInliers shortly after a relocalisation.
+  int minInliers(const Frame& F) const;
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
   // Projection search of kf's static points not yet matched in F, window th.
   int searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const;
