@@ -781,6 +781,7 @@ void Tracking::resetKeepTrajectory() {
   init_frame_id_ = -1;
   init_kf_id_ = -1;
   last_tracked_id_ = -1;
+  last_reloc_frame_id_ = -1;  // a relocalisation in the old map says nothing of the new one
   has_velocity_ = false;
   failures_in_row_ = 0;
   lost_frames_in_row_ = 0;

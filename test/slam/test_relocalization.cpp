@@ -99,3 +99,45 @@ TEST(SlamRelocalization, FramesAfterRelocalisationNeedRelocMinInliers) {
   EXPECT_EQ(r.tracked_after, 0);
   EXPECT_GE(r.relocalizations, 10u);
 }
+
+// A map reset forgets the relocalisations of the old map: Tracking.relocMinInliers out of reach
+// makes every relocalisation in a young map fail its local-map step, the young map is reset,
+// and the new map, started right after, tracks with the ordinary Tracking.minInliers.
+TEST(SlamRelocalization, NewMapAfterResetIgnoresOldRelocalisation) {
+  sim::SynthOptions so;
+  so.preset = "static_xyz";
+  so.frames = 40;
+  so.seed = 5;
+  sim::SequenceGenerator gen(so);
+  slam::SystemOptions opt = slam::SystemOptions::load(Config());
+  opt.screening.mode = screening::DynamicMode::Off;
+  opt.slam.loop.enabled = false;
+  opt.sequential = true;
+  opt.slam.tracking.young_map_frames = 30;
+  opt.slam.tracking.young_lost_reset_frames = 3;
+  opt.slam.tracking.reloc_min_inliers = 100000;
+  slam::System sys(gen.camera(), opt, shippedVocabulary());
+  double stamp = 0;
+  for (size_t i = 0; i < 10; ++i) {
+    const sim::SynthFrame f = gen.frame(i);
+    stamp = f.rgb_stamp;
+    ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
+  }
+  const sim::SynthFrame f0 = gen.frame(0);
+  const cv::Mat black(f0.bgr.size(), f0.bgr.type(), cv::Scalar::all(0));
+  const cv::Mat no_depth(f0.depth.size(), CV_32F, cv::Scalar(0));
+  for (int k = 0; k < 2; ++k) {
+    stamp += 1.0 / 30;
+    sys.trackRgbd(black, no_depth, stamp, {});
+  }
+  int tracked_after = 0;
+  for (size_t i = 2; i < 22; ++i) {  // back to frames mapped before the loss
+    const sim::SynthFrame f = gen.frame(i);
+    stamp += 1.0 / 30;
+    tracked_after += sys.trackRgbd(f.bgr, f.depth, stamp, {}).state == slam::TrackingState::Ok;
+  }
+  const slam::SystemStats st = sys.stats();
+  EXPECT_GE(st.relocalizations, 1u);
+  EXPECT_EQ(st.resets, 1u);
+  EXPECT_GE(tracked_after, 18);
+}
