@@ -17,6 +17,7 @@
 #include "yolo_slam/features/frame_builder.h"
 #include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/screening/screener.h"
+#include "gt_boxes.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -123,7 +124,28 @@ constexpr double kBehindM = 0.5;
 struct Misses {
   long outside_depth = 0, outside_hole = 0, in_box_hole = 0, box_dropped_nothing = 0;
   long nearer = 0, within = 0, behind = 0, far_behind = 0;
+  long far_behind_unboxed = 0;  // of far_behind: a ground-truth person around it has no box
 };
+
+// A ground-truth box is detected when a screened box overlaps it by this IoU.
+constexpr float kDetectedIou = 0.5f;
+
+float boxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
+  const float inter = (a & b).area();
+  const float uni = a.area() + b.area() - inter;
+  return uni > 0 ? inter / uni : 0.f;
+}
+
+// Some ground-truth person box containing p overlaps no screened box by kDetectedIou.
+bool nearUndetectedPerson(const detection::Boxes& truth, const detection::Boxes& boxes, cv::Point2f p) {
+  for (const auto& t : truth) {
+    if (!t.rect.contains(p)) continue;
+    bool found = false;
+    for (const auto& b : boxes) found = found || boxIou(t.rect, b.rect) >= kDetectedIou;
+    if (!found) return true;
+  }
+  return false;
+}
 
 // Median depth of the keypoints with depth dropped inside r (0 if none).
 float droppedDepth(const features::FeatureFrame& f, const cv::Rect2f& r) {
@@ -138,7 +160,7 @@ float droppedDepth(const features::FeatureFrame& f, const cv::Rect2f& r) {
 // In a box with depth, the keypoint is compared with the box (of those containing it) whose
 // dropped median depth is nearest to its own.
 void countMisses(const features::FeatureFrame& f, const cv::Mat& mask, const detection::Boxes& boxes,
-                 const ScreeningOptions& o, Misses& m) {
+                 const detection::Boxes& truth, const ScreeningOptions& o, Misses& m) {
   std::vector<cv::Rect2f> rects;
   std::vector<float> dropped_at;
   for (const auto& b : boxes) {
@@ -167,6 +189,7 @@ void countMisses(const features::FeatureFrame& f, const cv::Mat& mask, const det
       if (gap < -o.grow_depth_m) ++m.nearer;
       else if (gap <= o.grow_depth_m) ++m.within;
       else ++(gap <= kBehindM ? m.behind : m.far_behind);
+      if (gap > kBehindM && nearUndetectedPerson(truth, boxes, p)) ++m.far_behind_unboxed;
     }
   }
 }
@@ -199,6 +222,7 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
   cam.rgb_order = false;  // cv::imread gives BGR
   features::OrbExtractor orb{features::OrbOptions::load(cfg)};
   const auto boxes_of = readScreenedBoxes(joinPath(run_dir, "boxes_screened.txt"));
+  const auto truth_of = bench::readPersonBoxes(joinPath(dir, "boxes.txt"));
   const std::vector<Variant> vs = variants();
   std::vector<Split> split(vs.size());
   std::vector<long> hist(kBuckets.size(), 0), hist_hole(kBuckets.size(), 0);
@@ -231,7 +255,8 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
       count(f, mask, boxes, o.box_dilation, split[k]);
       if (k == 0) {
         distances(f, mask, hist, hist_hole);
-        countMisses(f, mask, boxes, o, misses);
+        const auto t = truth_of.find(bench::stampKey(std::stod(rgb_stamp)));
+        countMisses(f, mask, boxes, t == truth_of.end() ? detection::Boxes() : t->second, o, misses);
       }
     }
     ++used;
@@ -259,6 +284,9 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
               kBehindM, kBehindM, misses.outside_depth, misses.outside_hole, misses.in_box_hole,
               misses.box_dropped_nothing, misses.nearer, misses.within, misses.behind,
               misses.far_behind);
+  std::printf("\nof the %ld more than %.1f m behind, %ld lie in the ground-truth box of a person no "
+              "screened box overlaps by IoU %.1f (a person the detector missed)\n",
+              misses.far_behind, kBehindM, misses.far_behind_unboxed, kDetectedIou);
 }
 
 }  // namespace

@@ -200,6 +200,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.youngLostResetFrames",
       "Tracking.youngMapFrames",
       "Tracking.youngPointCheck",
+      "Tracking.boxedPointsStaticOnly",
   };
   return keys;
 }

@@ -81,6 +81,8 @@ void toMsg(const features::FeatureFrame& f, const detection::Boxes& boxes, Keypo
   msg.dynamic.resize(n, 0);
   if (f.motion.size() == n) msg.motion.assign(f.motion.begin(), f.motion.end());
   else msg.motion.clear();
+  if (f.boxed.size() == n) msg.boxed.assign(f.boxed.begin(), f.boxed.end());
+  else msg.boxed.clear();
   msg.boxes.clear();
   msg.boxes.reserve(boxes.size());
   for (const auto& b : boxes) msg.boxes.push_back(toMsg(b));
@@ -125,6 +127,7 @@ features::FeatureFrame fromMsg(const KeypointFrame& msg, const CameraModel& cam)
   f.depth.assign(msg.depth.begin(), msg.depth.end());
   f.dynamic.assign(msg.dynamic.begin(), msg.dynamic.end());
   if (msg.motion.size() == n) f.motion.assign(msg.motion.begin(), msg.motion.end());
+  if (msg.boxed.size() == n) f.boxed.assign(msg.boxed.begin(), msg.boxed.end());
   f.right_u.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const float d = f.depth[i];

@@ -658,6 +658,8 @@ ScreeningStats Screener::screen(features::FeatureFrame& frame, const detection::
       markRegion(opt_, frame, r, PersonPixels(), drop, st);
     } else {
       screenBoxes(*this, frame, boxes, depth_m, in_any, drop, st);
+      frame.boxed.assign(n, 0);
+      for (size_t i = 0; i < n; ++i) frame.boxed[i] = in_any[i] && !drop[i] && !frame.dynamic[i];
     }
     applyDrops(in_any, drop, frame, st);
   }

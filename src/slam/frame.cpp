@@ -68,6 +68,8 @@ Frame::Frame(const features::FeatureFrame& ff, const CameraModel& camera, const 
   dynamic.assign(N, 0);
   if (ff.motion.size() == static_cast<size_t>(N)) motion.assign(ff.motion.begin(), ff.motion.end());
   else motion.clear();
+  if (ff.boxed.size() == static_cast<size_t>(N)) boxed.assign(ff.boxed.begin(), ff.boxed.end());
+  else boxed.clear();
   for (int i = 0; i < N; ++i) {
     if (static_cast<size_t>(i) < ff.depth.size()) {
       float d = ff.depth[i];
@@ -157,6 +159,7 @@ void Frame::releaseFeatures() {
   std::vector<float>().swap(right_u);
   std::vector<uint8_t>().swap(dynamic);
   std::vector<int8_t>().swap(motion);
+  std::vector<uint8_t>().swap(boxed);
   std::vector<MapPointPtr>().swap(points);
   std::vector<bool>().swap(outlier);
   bow = BowData();

@@ -38,6 +38,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
       {"Tracking.localMapFromPrediction", &O::local_map_from_prediction},
       {"Tracking.youngPointCheck", &O::young_point_check},
+      {"Tracking.boxedPointsStaticOnly", &O::boxed_points_static_only},
   };
   return table;
 }

@@ -703,6 +703,12 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
   return mapper_->queued() < static_cast<size_t>(mapper_->queueCapacity());
 }
 
+bool Tracking::mayMakeKeyFramePoint(const Frame& F, int i) const {
+  // A young map made while people filled the view needs every static point it can get.
+  if (!opt_.boxed_points_static_only || youngMap(F) || F.boxed.empty() || !F.boxed[i]) return true;
+  return !F.motion.empty() && F.motion[i] == 1;
+}
+
 void Tracking::createNewKeyFrame(Frame& F) {
   auto kf = std::make_shared<KeyFrame>(map_.newKeyFrameId(), F);
   computeBow(voc_.get(), kf->f);
@@ -715,6 +721,10 @@ void Tracking::createNewKeyFrame(Frame& F) {
     const int i = e.second;
     const MapPointPtr& cur = kf->f.points[i];
     if (!cur || cur->numObservations() < 1) {
+      if (!mayMakeKeyFramePoint(F, i)) {
+        ++boxed_withheld_;
+        continue;
+      }
       if (!createDepthPoint(kf, F, i)) continue;
     }
     ++n;

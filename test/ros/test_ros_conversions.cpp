@@ -56,6 +56,7 @@ static features::FeatureFrame makeFrame(size_t n) {
     f.depth.push_back(i % 3 == 0 ? 0.f : 1.0f + 0.1f * i);
     f.dynamic.push_back(i % 4 == 0 ? 1 : 0);
     f.motion.push_back(static_cast<int8_t>(static_cast<int>(i % 3) - 1));
+    f.boxed.push_back(i % 5 == 1 ? 1 : 0);
     for (int j = 0; j < 32; ++j) f.descriptors.at<uint8_t>(static_cast<int>(i), j) = static_cast<uint8_t>(i * 32 + j);
   }
   f.keypoints_un = f.keypoints;
@@ -77,6 +78,7 @@ TEST(Conversions, KeypointFrameRoundTrip) {
   CameraModel cam;  // no distortion
   const features::FeatureFrame g = ros1::fromMsg(msg, cam);
   ASSERT_EQ(g.motion.size(), 50u);
+  ASSERT_EQ(g.boxed.size(), 50u);
   EXPECT_DOUBLE_EQ(g.stamp, 12.5);
   EXPECT_EQ(g.width, 640);
   ASSERT_EQ(g.size(), 50u);
@@ -89,6 +91,7 @@ TEST(Conversions, KeypointFrameRoundTrip) {
     EXPECT_EQ(g.depth[i], f.depth[i]);
     EXPECT_EQ(g.dynamic[i], f.dynamic[i]);
     EXPECT_EQ(g.motion[i], f.motion[i]);
+    EXPECT_EQ(g.boxed[i], f.boxed[i]);
     if (f.depth[i] > 0)
       EXPECT_NEAR(g.right_u[i], f.keypoints[i].pt.x - cam.bf / f.depth[i], 1e-4);
     else

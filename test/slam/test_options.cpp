@@ -136,6 +136,7 @@ Tracking.maxJumpInliers: 90
 Tracking.maxStampGap: 0.5
 Tracking.localMapFromPrediction: 0
 Tracking.youngPointCheck: 0
+Tracking.boxedPointsStaticOnly: 0
 LocalMapping.triangulationNeighbours: 12
 LocalMapping.fuseNeighbours: 8
 LocalMapping.cullingRedundancy: 0.875
@@ -290,8 +291,8 @@ TEST(Options, EveryFieldHoldsItsValue) {
                      k.close_untracked_min, k.close_min_frames),
             std::make_tuple(20, 2, 0.875, 90, 60, 7));
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap,
-                     k.local_map_from_prediction, k.young_point_check),
-            std::make_tuple(120, 4, 80, 0.5, false, false));
+                     k.local_map_from_prediction, k.young_point_check, k.boxed_points_static_only),
+            std::make_tuple(120, 4, 80, 0.5, false, false, false));
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points, k.reloc_min_inliers),
             std::make_tuple(45, 3, 150, 40));
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),

@@ -7,6 +7,7 @@
 #include "yolo_slam/sim/generator.h"
 #include "yolo_slam/slam/system.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
+#include "support/static_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -28,11 +29,7 @@ struct JumpBack {
 
 // 100 frames of static_xyz, 5 blank frames (lost), then frames 10..30 again.
 JumpBack runJumpBack(slam::SystemOptions opt) {
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.frames = 100;
-  so.seed = 5;
-  sim::SequenceGenerator gen(so);
+  sim::SequenceGenerator gen(test_support::staticXyz(100, 5));
   EXPECT_EQ(gen.size(), 100u);
 
   opt.screening.mode = screening::DynamicMode::Off;
@@ -51,11 +48,10 @@ JumpBack runJumpBack(slam::SystemOptions opt) {
 
   // Blank frames: no features, no depth -> lost.
   sim::SynthFrame f0 = gen.frame(0);
-  cv::Mat black(f0.bgr.size(), f0.bgr.type(), cv::Scalar::all(0));
-  cv::Mat no_depth(f0.depth.size(), CV_32F, cv::Scalar(0));
+  const test_support::BlankFrame blank = test_support::blankFrame(f0);
   for (int k = 0; k < 5; ++k) {
     stamp += 1.0 / 30;
-    EXPECT_NE(sys.trackRgbd(black, no_depth, stamp, {}).state, slam::TrackingState::Ok);
+    EXPECT_NE(sys.trackRgbd(blank.bgr, blank.depth, stamp, {}).state, slam::TrackingState::Ok);
   }
   EXPECT_EQ(sys.state(), slam::TrackingState::Lost);
   const size_t relocs_before = sys.stats().relocalizations;
@@ -104,15 +100,8 @@ TEST(SlamRelocalization, FramesAfterRelocalisationNeedRelocMinInliers) {
 // makes every relocalisation in a young map fail its local-map step, the young map is reset,
 // and the new map, started right after, tracks with the ordinary Tracking.minInliers.
 TEST(SlamRelocalization, NewMapAfterResetIgnoresOldRelocalisation) {
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.frames = 40;
-  so.seed = 5;
-  sim::SequenceGenerator gen(so);
-  slam::SystemOptions opt = slam::SystemOptions::load(Config());
-  opt.screening.mode = screening::DynamicMode::Off;
-  opt.slam.loop.enabled = false;
-  opt.sequential = true;
+  sim::SequenceGenerator gen(test_support::staticXyz(40, 5));
+  slam::SystemOptions opt = test_support::plainSequentialOptions();
   opt.slam.tracking.young_map_frames = 30;
   opt.slam.tracking.young_lost_reset_frames = 3;
   opt.slam.tracking.reloc_min_inliers = 100000;
@@ -124,11 +113,10 @@ TEST(SlamRelocalization, NewMapAfterResetIgnoresOldRelocalisation) {
     ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
   }
   const sim::SynthFrame f0 = gen.frame(0);
-  const cv::Mat black(f0.bgr.size(), f0.bgr.type(), cv::Scalar::all(0));
-  const cv::Mat no_depth(f0.depth.size(), CV_32F, cv::Scalar(0));
+  const test_support::BlankFrame blank = test_support::blankFrame(f0);
   for (int k = 0; k < 2; ++k) {
     stamp += 1.0 / 30;
-    sys.trackRgbd(black, no_depth, stamp, {});
+    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
   }
   int tracked_after = 0;
   for (size_t i = 2; i < 22; ++i) {  // back to frames mapped before the loss

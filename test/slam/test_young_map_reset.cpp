@@ -7,6 +7,7 @@
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/sim/generator.h"
 #include "yolo_slam/slam/system.h"
+#include "support/static_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -22,15 +23,8 @@ struct Outcome {
 
 // Tracks `before` frames, then `blank` blank frames, then the next 10 real frames.
 Outcome runWithBlanks(int before, int blank, int young_lost_reset_frames) {
-  sim::SynthOptions so;
-  so.preset = "static_xyz";
-  so.frames = before + 10;
-  so.seed = 5;
-  sim::SequenceGenerator gen(so);
-  slam::SystemOptions opt = slam::SystemOptions::load(Config());
-  opt.screening.mode = screening::DynamicMode::Off;
-  opt.slam.loop.enabled = false;
-  opt.sequential = true;
+  sim::SequenceGenerator gen(test_support::staticXyz(before + 10, 5));
+  slam::SystemOptions opt = test_support::plainSequentialOptions();
   opt.slam.tracking.young_map_frames = 30;
   opt.slam.tracking.young_lost_reset_frames = young_lost_reset_frames;
   slam::System sys(gen.camera(), opt, nullptr);  // no vocabulary: no BoW relocalisation
@@ -41,11 +35,10 @@ Outcome runWithBlanks(int before, int blank, int young_lost_reset_frames) {
     EXPECT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
   }
   const sim::SynthFrame f0 = gen.frame(0);
-  const cv::Mat black(f0.bgr.size(), f0.bgr.type(), cv::Scalar::all(0));
-  const cv::Mat no_depth(f0.depth.size(), CV_32F, cv::Scalar(0));
+  const test_support::BlankFrame blank_frame = test_support::blankFrame(f0);
   for (int k = 0; k < blank; ++k) {
     stamp += 1.0 / 30;
-    sys.trackRgbd(black, no_depth, stamp, {});
+    sys.trackRgbd(blank_frame.bgr, blank_frame.depth, stamp, {});
   }
   Outcome out;
   for (int i = before; i < before + 10; ++i) {

@@ -31,6 +31,9 @@ struct FeatureFrame {
   // would be, 0 moved, -1 untested; empty when the test did not run. Tracking marks a map point
   // dynamic only on evidence that is not "static-consistent".
   std::vector<int8_t> motion;
+  // 1 = inside a person box and screened static there (background seen past a person, or a
+  // person the screening could not separate from it); empty when no box screening ran.
+  std::vector<uint8_t> boxed;
 
   size_t size() const { return keypoints.size(); }
   size_t countDynamic() const {

@@ -57,6 +57,7 @@ class Frame {
   std::vector<float> right_u;      // virtual right coordinate, < 0 invalid
   std::vector<uint8_t> dynamic;    // 1: screened dynamic, never used
   std::vector<int8_t> motion;      // FeatureFrame::motion (1 static-consistent, 0 moved, -1 untested); empty: not run
+  std::vector<uint8_t> boxed;      // FeatureFrame::boxed; empty: no box screening
   std::vector<MapPointPtr> points; // association per keypoint (null = none)
   std::vector<bool> outlier;       // set by pose optimisation
   BowData bow;                     // filled only when a vocabulary is used

@@ -73,6 +73,7 @@ class Tracking {
   size_t trackedFromPrediction() const { return from_prediction_; }
   // Matches of once-seen map points released by Tracking.youngPointCheck.
   size_t youngPointsDropped() const { return young_dropped_; }
+  size_t boxedPointsWithheld() const { return boxed_withheld_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -107,6 +108,8 @@ class Tracking {
   void startFromPrediction(Frame& F, const Pose& prediction) const;
   // Inliers the local-map step needs: Tracking.relocMinInliers shortly after a relocalisation.
   int minInliers(const Frame& F) const;
+  // Whether a new keyframe may make a map point of keypoint i (Tracking.boxedPointsStaticOnly).
+  bool mayMakeKeyFramePoint(const Frame& F, int i) const;
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
   // Projection search of kf's static points not yet matched in F, window th.
   int searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const;
@@ -183,6 +186,7 @@ class Tracking {
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
+  size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly
   long init_kf_id_ = -1;      // the first keyframe of the map being built (-1: a loaded map)
 };
 
