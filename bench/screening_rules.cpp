@@ -3,6 +3,7 @@
 // the static keypoints the defaults drop (and the people's keypoints they drop) to the rules by
 // turning one rule off at a time:
 //   screening_rules --sequence SEQ --run RUN [--stride N] [--max-frames N] [--set KEY=VALUE]...
+//                   [--detected-iou X]
 // The configuration is SEQ/camera.yaml with the --set overrides (the same keys as yolo_slam_run).
 // Only Screener::screen is replayed: the static-box veto, motion screening and the adaptive
 // feature budget of the run are not (set ORBextractor.nFeatures to the run's mean budget to
@@ -127,8 +128,8 @@ struct Misses {
   long far_behind_unboxed = 0;  // of far_behind: a ground-truth person around it has no box
 };
 
-// A ground-truth box is detected when a screened box overlaps it by this IoU.
-constexpr float kDetectedIou = 0.5f;
+// A ground-truth box is detected when a screened box overlaps it by this IoU (--detected-iou).
+constexpr float kDefaultDetectedIou = 0.5f;
 
 float boxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
   const float inter = (a & b).area();
@@ -137,11 +138,12 @@ float boxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
 }
 
 // Some ground-truth person box containing p overlaps no screened box by kDetectedIou.
-bool nearUndetectedPerson(const detection::Boxes& truth, const detection::Boxes& boxes, cv::Point2f p) {
+bool nearUndetectedPerson(const detection::Boxes& truth, const detection::Boxes& boxes, cv::Point2f p,
+                          float detected_iou) {
   for (const auto& t : truth) {
     if (!t.rect.contains(p)) continue;
     bool found = false;
-    for (const auto& b : boxes) found = found || boxIou(t.rect, b.rect) >= kDetectedIou;
+    for (const auto& b : boxes) found = found || boxIou(t.rect, b.rect) >= detected_iou;
     if (!found) return true;
   }
   return false;
@@ -160,7 +162,7 @@ float droppedDepth(const features::FeatureFrame& f, const cv::Rect2f& r) {
 // In a box with depth, the keypoint is compared with the box (of those containing it) whose
 // dropped median depth is nearest to its own.
 void countMisses(const features::FeatureFrame& f, const cv::Mat& mask, const detection::Boxes& boxes,
-                 const detection::Boxes& truth, const ScreeningOptions& o, Misses& m) {
+                 const detection::Boxes& truth, const ScreeningOptions& o, float detected_iou, Misses& m) {
   std::vector<cv::Rect2f> rects;
   std::vector<float> dropped_at;
   for (const auto& b : boxes) {
@@ -189,7 +191,7 @@ void countMisses(const features::FeatureFrame& f, const cv::Mat& mask, const det
       if (gap < -o.grow_depth_m) ++m.nearer;
       else if (gap <= o.grow_depth_m) ++m.within;
       else ++(gap <= kBehindM ? m.behind : m.far_behind);
-      if (gap > kBehindM && nearUndetectedPerson(truth, boxes, p)) ++m.far_behind_unboxed;
+      if (gap > kBehindM && nearUndetectedPerson(truth, boxes, p, detected_iou)) ++m.far_behind_unboxed;
     }
   }
 }
@@ -214,7 +216,7 @@ void distances(const features::FeatureFrame& f, const cv::Mat& mask, std::vector
 }
 
 void run(const std::string& dir, const std::string& run_dir, int stride, int max_frames,
-         const std::vector<std::string>& sets) {
+         const std::vector<std::string>& sets, float detected_iou) {
   Config cfg = Config::fromFile(joinPath(dir, "camera.yaml"));
   for (const auto& s : sets) cfg.setFromAssignment(s);
   const ScreeningOptions base = ScreeningOptions::load(cfg);
@@ -256,7 +258,7 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
       if (k == 0) {
         distances(f, mask, hist, hist_hole);
         const auto t = truth_of.find(bench::stampKey(std::stod(rgb_stamp)));
-        countMisses(f, mask, boxes, t == truth_of.end() ? detection::Boxes() : t->second, o, misses);
+        countMisses(f, mask, boxes, t == truth_of.end() ? detection::Boxes() : t->second, o, detected_iou, misses);
       }
     }
     ++used;
@@ -285,8 +287,8 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
               misses.box_dropped_nothing, misses.nearer, misses.within, misses.behind,
               misses.far_behind);
   std::printf("\nof the %ld more than %.1f m behind, %ld lie in the ground-truth box of a person no "
-              "screened box overlaps by IoU %.1f (a person the detector missed)\n",
-              misses.far_behind, kBehindM, misses.far_behind_unboxed, kDetectedIou);
+              "screened box overlaps by IoU %.2f (missed, or boxed loosely at that IoU)\n",
+              misses.far_behind, kBehindM, misses.far_behind_unboxed, detected_iou);
 }
 
 }  // namespace
@@ -294,6 +296,7 @@ void run(const std::string& dir, const std::string& run_dir, int stride, int max
 int main(int argc, char** argv) {
   std::string sequence, run_dir;
   int stride = 5, max_frames = 1 << 30;
+  float detected_iou = kDefaultDetectedIou;
   std::vector<std::string> sets;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -307,14 +310,15 @@ int main(int argc, char** argv) {
       else if (a == "--stride") stride = std::max(1, std::stoi(next()));
       else if (a == "--max-frames") max_frames = std::stoi(next());
       else if (a == "--set") sets.push_back(next());
+      else if (a == "--detected-iou") detected_iou = std::stof(next());
       else if (a == "--help" || a == "-h") {
         std::printf("usage: screening_rules --sequence SEQ --run RUN [--stride N] [--max-frames N] "
-                    "[--set KEY=VALUE]...\n");
+                    "[--set KEY=VALUE]... [--detected-iou X]\n");
         return 0;
       } else throw Error("unknown option " + a + " (see --help)");
     }
     if (sequence.empty() || run_dir.empty()) throw Error("--sequence and --run are required (see --help)");
-    run(sequence, run_dir, stride, max_frames, sets);
+    run(sequence, run_dir, stride, max_frames, sets, detected_iou);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
