@@ -69,9 +69,9 @@ struct TrackingOptions {
   // they are not matched in this frame. A person the screening missed when a keyframe was made
   // is otherwise in the map at once, and the next frames' poses follow the person.
   bool young_point_check = true;  // Tracking.youngPointCheck
-  // Beyond ORB-SLAM2: a keypoint screened static inside a person box (FeatureFrame::boxed) gives
-  // a new keyframe a map point only when the frame-to-frame test found it where a static point
-  // would be (FeatureFrame::motion 1). The screening keeps what lies behind the boxed person's
+  // Beyond ORB-SLAM2: past a map's first young_map_frames frames, a keypoint screened static
+  // inside a person box (FeatureFrame::boxed) gives a new keyframe a map point only when the
+  // frame-to-frame test found it where a static point would be (FeatureFrame::motion 1). The screening keeps what lies behind the boxed person's
   // depth cluster: mostly the room, sometimes a person the detector missed behind the boxed
   // one, whose points would pull the next frames' poses. They still match existing map points.
   bool boxed_points_static_only = true;  // Tracking.boxedPointsStaticOnly
