@@ -4,24 +4,27 @@
 # two people walking; evaluate the second run in the first map's frame (the mapping run's
 # alignment onto the ground truth, not a new one).
 #
-#   bench/map_reuse.sh [--bin DIR] [--out DIR] [--frames N] [--seed S]
+#   bench/map_reuse.sh [--bin DIR] [--out DIR] [--frames N] [--seed S] [--loc-preset P]
 #
 # Mapping: preset static_xyz (camera translating along its axes, no people). Localization:
-# preset walking_xyz (the real fr3_walking_xyz camera path, two people). Both start at the same
-# place in the room. Prints frames tracked, when the first pose came (relocalisation), the map
-# file's size and load time, and the ATE in the map's frame; writes OUT/summary.json.
+# preset P (default walking_xyz: the real fr3_walking_xyz camera path, two people; crowd and
+# close have the same path). Both start at the same place in the seed's room. Prints frames
+# tracked, when the first pose came (relocalisation), the map file's size and load time, and
+# the ATE in the map's frame; writes OUT/summary.json.
 set -euo pipefail
 bin=build/ws/devel/lib/yolo_slam
 out=out/map_reuse
 frames=0
 seed=1
+loc_preset=walking_xyz
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) bin="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --frames) frames="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    --loc-preset) loc_preset="$2"; shift 2 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "error: unknown option '$1'; see --help" >&2; exit 1 ;;
   esac
 done
@@ -31,7 +34,7 @@ done
 mkdir -p "$out"
 echo "map_reuse: $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)"
 "$bin/yolo_slam_synth" --preset static_xyz --seed "$seed" --frames "$frames" --out "$out/map_seq" > /dev/null
-"$bin/yolo_slam_synth" --preset walking_xyz --seed "$seed" --frames "$frames" --out "$out/loc_seq" > /dev/null
+"$bin/yolo_slam_synth" --preset "$loc_preset" --seed "$seed" --frames "$frames" --out "$out/loc_seq" > /dev/null
 "$bin/yolo_slam_run" --sequence "$out/map_seq" --out "$out/map_run" --save-map "$out/room.ysmap" > "$out/map_run.log" 2>&1
 "$bin/yolo_slam_run" --sequence "$out/loc_seq" --out "$out/loc_run" --load-map "$out/room.ysmap" --localization \
   > "$out/loc_run.log" 2>&1

@@ -196,6 +196,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.relocMinInliers",
       "Tracking.motionWindow",
       "Tracking.refRatio",
+      "Tracking.voBelowMapPoints",
       "Tracking.voPoints",
       "Tracking.youngLostResetFrames",
       "Tracking.youngMapFrames",

@@ -138,6 +138,12 @@ int Frame::countWithDepth() const {
   return n;
 }
 
+bool Frame::seenMoving(int i) const {
+  const bool tested = !motion.empty();
+  if (tested && motion[i] == 0) return true;
+  return !boxed.empty() && boxed[i] && !(tested && motion[i] == 1);
+}
+
 std::vector<std::pair<float, int>> Frame::staticByDepth() const {
   std::vector<std::pair<float, int>> out;
   for (int i = 0; i < N; ++i)

@@ -30,6 +30,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.youngMapFrames", &O::young_map_frames, Range::atLeast(1)},
       {"Tracking.youngLostResetFrames", &O::young_lost_reset_frames, Range::atLeast(0)},
       {"Tracking.voPoints", &O::vo_points, Range::atLeast(0)},
+      {"Tracking.voBelowMapPoints", &O::vo_below_map_points, Range::atLeast(0)},
       {"Tracking.motionPrior", &O::motion_prior, Range::closed(0, 1e6)},
       {"Tracking.motionPriorDeg", &O::motion_prior_deg, Range::closed(0.01, 180)},
       {"Tracking.maxJump", &O::max_jump, Range::closed(0, 1e6)},

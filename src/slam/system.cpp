@@ -450,7 +450,7 @@ SystemStats System::stats() const {
   }
   LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
-  size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0;
+  size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0, vo_frames = 0;
   {
     std::lock_guard<std::mutex> tl(track_mutex_);
     relocs = tracker_->relocalizations();
@@ -458,6 +458,7 @@ SystemStats System::stats() const {
     from_prediction = tracker_->trackedFromPrediction();
     young_dropped = tracker_->youngPointsDropped();
     boxed_withheld = tracker_->boxedPointsWithheld();
+    vo_frames = tracker_->voFrames();
   }
   const size_t loops = loop_closer_ ? loop_closer_->loopsClosed() : 0;
   const size_t gbas = loop_closer_ ? loop_closer_->globalBundleAdjustments() : 0;
@@ -477,6 +478,7 @@ SystemStats System::stats() const {
   s.tracked_from_prediction = from_prediction;
   s.young_points_dropped = young_dropped;
   s.boxed_points_withheld = boxed_withheld;
+  s.vo_frames = vo_frames;
   s.loops_closed = loops;
   s.global_bas = gbas;
   return s;
@@ -514,6 +516,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"tracked_from_prediction", s.tracked_from_prediction},
               {"young_points_dropped", s.young_points_dropped},
               {"boxed_points_withheld", s.boxed_points_withheld},
+              {"vo_frames", s.vo_frames},
               {"loops_closed", s.loops_closed},
               {"global_bundle_adjustments", s.global_bas},
               {"awaiting_detection", s.awaiting_detection},

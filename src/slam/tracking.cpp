@@ -336,12 +336,23 @@ void Tracking::updateLastFrame() {
 }
 
 void Tracking::addTemporaryPoints() {
+  int map_points = 0;
+  for (int i = 0; i < last_.N; ++i)
+    if (last_.points[i] && last_.points[i]->numObservations() > 0) ++map_points;
+  if (map_points >= opt_.vo_below_map_points) return;
+  const size_t before = temporary_points_.size();
+  addTemporaryCloseFirst();
+  if (temporary_points_.size() > before) ++vo_frames_;
+}
+
+void Tracking::addTemporaryCloseFirst() {
   const std::vector<std::pair<float, int>> by_depth = last_.staticByDepth();
   int n = 0;
   for (const auto& e : by_depth) {
     const int i = e.second;
     const MapPointPtr& mp = last_.points[i];
     if (!mp || mp->numObservations() < 1) {
+      if (last_.seenMoving(i)) continue;
       Eigen::Vector3d Xw;
       if (!last_.unprojectWorld(i, Xw)) continue;
       auto tmp = std::make_shared<MapPoint>(-1, Xw, nullptr, last_.id);

@@ -128,6 +128,7 @@ Tracking.lostResetMaxKeyFrames: 4
 Tracking.youngMapFrames: 45
 Tracking.youngLostResetFrames: 3
 Tracking.voPoints: 80
+Tracking.voBelowMapPoints: 40
 Tracking.motionPrior: 0.03125
 Tracking.motionPriorDeg: 1.5
 Tracking.maxJump: 0.125
@@ -295,6 +296,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
             std::make_tuple(120, 4, 80, 0.5, false, false, false));
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points, k.reloc_min_inliers),
             std::make_tuple(45, 3, 150, 40));
+  EXPECT_EQ(k.vo_below_map_points, 40);
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   const slam::LocalMappingOptions& p = sys.slam.mapping;

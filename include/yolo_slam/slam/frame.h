@@ -69,6 +69,9 @@ class Frame {
   std::shared_ptr<const ScalePyramid> pyramid;
 
   void setPose(const Pose& T) { T_cw = T; }
+  // The frame-to-frame evidence saw keypoint i move: found moved, or kept static inside a person
+  // box without being found static-consistent.
+  bool seenMoving(int i) const;
   // Frees the keypoints, descriptors, BoW and grid (N becomes 0), keeping pose and camera. For
   // erased keyframes: the trajectory still refers to them for its relative poses, and without
   // this each would keep its features (about 250 KB) for the rest of the run.

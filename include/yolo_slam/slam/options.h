@@ -44,6 +44,12 @@ struct TrackingOptions {
   int young_map_frames = 30;        // Tracking.youngMapFrames
   int young_lost_reset_frames = 10; // Tracking.youngLostResetFrames
   int vo_points = 100;              // Tracking.voPoints: temporary close points in the last frame
+  // Localization mode makes them only when the last frame tracked fewer map points than this
+  // (ORB-SLAM2 makes them on every frame: a large value), and never of a keypoint the
+  // frame-to-frame test found moved or of one kept static in a person box without that test
+  // finding it static. With enough map points they add little but the people screening missed,
+  // who pull the pose along (crowd seed 1 in a map of its empty room: 45 mm -> 6 mm).
+  int vo_below_map_points = 50;     // Tracking.voBelowMapPoints
   // Motion prior (beyond ORB-SLAM2): a frame tracked with the motion model is optimised with a
   // Gaussian prior at the constant-velocity prediction, sigma motionPrior metres for the camera
   // centre and motionPriorDeg degrees, times the frames since the last one. Strong static

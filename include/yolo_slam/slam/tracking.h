@@ -74,6 +74,9 @@ class Tracking {
   // Matches of once-seen map points released by Tracking.youngPointCheck.
   size_t youngPointsDropped() const { return young_dropped_; }
   size_t boxedPointsWithheld() const { return boxed_withheld_; }
+  // Localization mode: frames tracked with temporary points in the last frame (Tracking.voPoints,
+  // voBelowMapPoints).
+  size_t voFrames() const { return vo_frames_; }
   const Trajectory& frozenKeyFrames() const { return frozen_keyframes_; }
   // Called by System before the map is cleared: remembers the keyframe poses of the old map.
   void freezeKeyFrames(const Trajectory& kfs) { frozen_keyframes_.insert(frozen_keyframes_.end(), kfs.begin(), kfs.end()); }
@@ -126,8 +129,13 @@ class Tracking {
   int dropDisagreeingYoungPoints(Frame& F);
   // Re-anchors the last frame on its (possibly refined or erased) reference keyframe.
   void updateLastFrame();
-  // Localization mode: temporary close points in the last frame for visual odometry.
+  // Localization mode: temporary close points in the last frame for visual odometry, when it
+  // tracked fewer than Tracking.voBelowMapPoints map points.
   void addTemporaryPoints();
+  // The last frame's static keypoints with depth not seen moving (Frame::seenMoving), nearest
+  // first: all closer than ThDepth, at least Tracking.voPoints.
+  void addTemporaryCloseFirst();
+
   void updateLocalMap(Frame& F);
   void searchLocalPoints(Frame& F);
   int optimizePose(Frame& F);
@@ -187,6 +195,7 @@ class Tracking {
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
   size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly
+  size_t vo_frames_ = 0;       // frames whose last frame got temporary points
   long init_kf_id_ = -1;      // the first keyframe of the map being built (-1: a loaded map)
 };
 
