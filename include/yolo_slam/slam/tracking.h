@@ -135,7 +135,6 @@ class Tracking {
   // The last frame's static keypoints with depth not seen moving (Frame::seenMoving), nearest
   // first: all closer than ThDepth, at least Tracking.voPoints.
   void addTemporaryCloseFirst();
-
   void updateLocalMap(Frame& F);
   void searchLocalPoints(Frame& F);
   int optimizePose(Frame& F);
