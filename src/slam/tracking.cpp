@@ -717,7 +717,7 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
 bool Tracking::mayMakeKeyFramePoint(const Frame& F, int i) const {
   // A young map made while people filled the view needs every static point it can get.
   if (!opt_.boxed_points_static_only || youngMap(F) || F.boxed.empty() || !F.boxed[i]) return true;
-  return !F.motion.empty() && F.motion[i] == 1;
+  return !F.seenMoving(i);
 }
 
 void Tracking::createNewKeyFrame(Frame& F) {
