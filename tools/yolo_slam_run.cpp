@@ -338,6 +338,7 @@ struct Prepared {
   std::string mask_path;
   std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
   bool detector_ran = true;  // false: async detection had no new result for this frame
+  std::optional<slam::ExtractedFrame> extracted;  // extracted ahead (ExtractAhead)
 };
 
 std::string baseName(const std::string& path) {
@@ -687,7 +688,7 @@ void countUntracked(const slam::System& system, const Prepared& p, UntrackedCoun
     ++c.lost;
 }
 
-void trackFrame(slam::System& system, const Prepared& p, PartialOutputs& outputs, LoopResult& res) {
+void trackFrame(slam::System& system, Prepared& p, PartialOutputs& outputs, LoopResult& res) {
   if (!p.warning.empty()) std::fprintf(stderr, "\nwarning: frame %zu (%.6f): %s\n", p.index, p.stamp, p.warning.c_str());
   if (p.detection_ms >= 0) system.recordDetectionTime(p.detection_ms);
   if (!p.has_image) {
@@ -695,7 +696,8 @@ void trackFrame(slam::System& system, const Prepared& p, PartialOutputs& outputs
     ++res.untracked.no_image;
     return;
   }
-  const slam::TrackResult r = system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes, p.detector_ran);
+  const slam::TrackResult r = p.extracted ? system.trackExtracted(std::move(*p.extracted), p.boxes, p.detector_ran)
+                                           : system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes, p.detector_ran);
   if (r.state == slam::TrackingState::Ok) {
     outputs.trajectory->append(io::formatTumPose(StampedPose{p.stamp, r.T_wc}));
   } else {
@@ -708,8 +710,8 @@ void trackFrame(slam::System& system, const Prepared& p, PartialOutputs& outputs
 }
 
 template <class Source>
-void runFrames(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
-               LoopResult& res) {
+void runFrameLoop(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
+                  LoopResult& res) {
   ProgressBar bar("yolo_slam_run", setup.frames);
   detection::BoxFeed feed(setup.max_box_age_s);
   while (!stopRequested()) {
@@ -726,6 +728,51 @@ void runFrames(Source& source, const RunSetup& setup, slam::System& system, Part
     bar.update(p->index + 1, extra);
   }
   bar.finish();
+}
+
+// Not --sequential: each frame is extracted on a worker while the frame before it is screened
+// and tracked (System::extractFrame), so the frame loop's thread does only screening and
+// tracking. The asynchronous detector is offered a frame by the frame loop, when the frame is
+// screened: Detection.asyncMaxLag counts frames screened.
+template <class Source>
+class ExtractAhead {
+ public:
+  ExtractAhead(Source& source, slam::System& system) : source_(source), system_(system) {
+    start();
+  }
+  ~ExtractAhead() {
+    if (next_.valid()) next_.wait();
+  }
+  std::optional<Prepared> next() {
+    std::optional<Prepared> p = next_.get();
+    if (p) start();
+    return p;
+  }
+
+ private:
+  void start() {
+    next_ = std::async(std::launch::async, [this] {
+      nameThisThread("ys_extract");
+      std::optional<Prepared> p = source_.next();
+      if (!p || !p->has_image) return p;
+      p->extracted = system_.extractFrame(p->bgr, p->depth, p->stamp);
+      return p;
+    });
+  }
+  Source& source_;
+  slam::System& system_;
+  std::future<std::optional<Prepared>> next_;
+};
+
+template <class Source>
+void runFrames(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
+               LoopResult& res) {
+  if (!system.sequential()) {
+    ExtractAhead<Source> ahead(source, system);
+    runFrameLoop(ahead, setup, system, outputs, res);
+  } else {
+    runFrameLoop(source, setup, system, outputs, res);
+  }
 }
 
 LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system, PartialOutputs& outputs) {

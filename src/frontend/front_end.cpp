@@ -54,18 +54,29 @@ size_t FrontEnd::budgetStep() const {
   return std::min(step, orb_.size() - 1);
 }
 
-FrontEndResult FrontEnd::extractAndScreen(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
-                                          const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
-  FrontEndResult r;
+Extracted FrontEnd::extractWith(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
+                                const CameraModel& cam) const {
+  Extracted ex;
   Stopwatch sw;
-  r.frame = features::buildFeatureFrame(*orb_[step], cam, image, depth, stamp);
-  r.stats.extraction_ms = sw.ms();
-  r.stats.feature_budget = 1 + kBoostStep * step;
-  sw.restart();
+  ex.frame = features::buildFeatureFrame(*orb_[step], cam, image, depth, stamp);
+  ex.extraction_ms = sw.ms();
+  ex.image = image;
+  ex.depth = depth;
+  ex.budget_step = step;
+  return ex;
+}
+
+FrontEndResult FrontEnd::screenExtracted(Extracted ex, const detection::Boxes& boxes, const CameraModel& cam,
+                                         bool detector_ran) {
+  FrontEndResult r;
+  r.frame = std::move(ex.frame);
+  r.stats.extraction_ms = ex.extraction_ms;
+  r.stats.feature_budget = 1 + kBoostStep * ex.budget_step;
+  Stopwatch sw;
   screening::PipelineResult screened;
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    screened = screening_->process(r.frame, boxes, cam, depth, detector_ran);
+    screened = screening_->process(r.frame, boxes, cam, ex.depth, detector_ran);
     const size_t n = r.frame.size();
     dropped_share_ = n > 0 ? static_cast<float>(r.frame.countDynamic()) / n : 0.f;
   }
@@ -76,12 +87,19 @@ FrontEndResult FrontEnd::extractAndScreen(size_t step, const cv::Mat& image, con
   return r;
 }
 
-FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                                 const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
+Extracted FrontEnd::extract(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                            const CameraModel& cam) const {
   if (image.empty()) throw Error("frame " + std::to_string(stamp) + ": empty image");
   const cv::Mat depth = checkedDepth(depth_m, image, stamp, cam.max_depth);
-  const size_t step = budgetStep();
-  FrontEndResult r = extractAndScreen(step, image, depth, stamp, boxes, cam, detector_ran);
+  return extractWith(budgetStep(), image, depth, stamp, cam);
+}
+
+FrontEndResult FrontEnd::screen(Extracted ex, const detection::Boxes& boxes, const CameraModel& cam,
+                                bool detector_ran) {
+  const cv::Mat image = ex.image, depth = ex.depth;
+  const double stamp = ex.frame.stamp;
+  const size_t step = ex.budget_step;
+  FrontEndResult r = screenExtracted(std::move(ex), boxes, cam, detector_ran);
   // The first frame of a stream has no last frame to size its budget by, and SLAM initialises
   // on it: when it needed more, it is extracted again (screening has seen nothing else yet).
   const size_t needed = budgetStep();
@@ -89,13 +107,18 @@ FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, d
     const double first_ms = r.stats.extraction_ms + r.stats.screening_ms;
     clear();
     fresh_ = false;
-    r = extractAndScreen(needed, image, depth, stamp, boxes, cam, detector_ran);
+    r = screenExtracted(extractWith(needed, image, depth, stamp, cam), boxes, cam, detector_ran);
     r.stats.extraction_ms += first_ms;
   }
   // After the re-extraction above: its clear() forgets earlier detections, not this frame's.
   if (detector_ran) seen_detection_ = true;
   r.awaiting_detection = needs_boxes_ && !seen_detection_;
   return r;
+}
+
+FrontEndResult FrontEnd::process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                                 const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran) {
+  return screen(extract(image, depth_m, stamp, cam), boxes, cam, detector_ran);
 }
 
 void FrontEnd::clear() {

@@ -140,19 +140,53 @@ void checkImageSize(const cv::Mat& image, const CameraModel& cam, double stamp) 
 }
 }  // namespace
 
-TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
-                              const detection::Boxes& boxes, bool detector_ran) {
+namespace {
+// The front end names the frame in most of its errors; the others get it here.
+std::string namingTheFrame(const std::string& error, double stamp) {
+  if (error.rfind("frame ", 0) == 0) return error;
+  return "frame " + formatNumber(stamp) + ": " + error;
+}
+}  // namespace
+
+frontend::FrontEnd& System::frontEnd() {
   std::call_once(front_end_once_, [this] {
     front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
   });
+  return *front_end_;
+}
+
+ExtractedFrame System::extractFrame(const cv::Mat& image, const cv::Mat& depth_m, double stamp) {
   checkImageSize(image, cam_, stamp);
-  frontend::FrontEndResult fe;
+  ExtractedFrame ef;
+  ef.stamp = stamp;
+  ef.image = image;
+  ef.depth_m = usableDepth(depth_m, image, stamp);
   try {
-    fe = front_end_->process(image, usableDepth(depth_m, image, stamp), stamp, boxes, cam_, detector_ran);
+    ef.extracted = frontEnd().extract(image, ef.depth_m, stamp, cam_);
   } catch (const Error& e) {
-    log::warn("frame %.6f: %s; frame reported lost", stamp, e.what());
+    ef.error = namingTheFrame(e.what(), stamp);
+  }
+  return ef;
+}
+
+TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
+                              const detection::Boxes& boxes, bool detector_ran) {
+  return trackExtracted(extractFrame(image, depth_m, stamp), boxes, detector_ran);
+}
+
+TrackResult System::trackExtracted(ExtractedFrame ef, const detection::Boxes& boxes, bool detector_ran) {
+  frontend::FrontEndResult fe;
+  if (ef.error.empty()) {
+    try {
+      fe = frontEnd().screen(std::move(ef.extracted), boxes, cam_, detector_ran);
+    } catch (const Error& e) {
+      ef.error = namingTheFrame(e.what(), ef.stamp);
+    }
+  }
+  if (!ef.error.empty()) {
+    log::warn("%s; frame reported lost", ef.error.c_str());
     fe = frontend::FrontEndResult();
-    fe.frame.stamp = stamp;
+    fe.frame.stamp = ef.stamp;
   }
   BoxCounts box_counts;
   for (const auto& b : fe.boxes) ++(b.tracked ? box_counts.tracked : box_counts.detected);
@@ -174,7 +208,7 @@ TrackResult System::trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, doub
   // tracking would hold on to them (asynchronous detection, before its first result).
   if (fe.awaiting_detection && state() == TrackingState::NotInitialized) return skipAwaitingDetection();
   const TrackResult res = trackFeatures(fe.frame);
-  addDenseKeyFrame(res, image, usableDepth(depth_m, image, stamp), fe.boxes);
+  addDenseKeyFrame(res, ef.image, ef.depth_m, fe.boxes);
   return res;
 }
 

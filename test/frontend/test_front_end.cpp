@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <future>
 #include <limits>
 
 using namespace yolo_slam;
@@ -174,4 +175,36 @@ TEST(FrontEnd, ModesWithoutBoxesNeverAwaitADetection) {
     frontend::FrontEnd fe = makeFrontEnd(mode);
     EXPECT_FALSE(fe.process(texture(1), wallWithPerson(), 0.0, {}, CameraModel(), false).awaiting_detection);
   }
+}
+
+TEST(FrontEnd, ExtractingTheNextFrameOnAnotherThreadScreensAsProcessDoes) {
+  // yolo_slam_run extracts frame k+1 on a worker while frame k is screened and tracked.
+  frontend::FrontEnd serial = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  frontend::FrontEnd ahead = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  const int kFrames = 4;
+  std::future<frontend::Extracted> next = std::async(std::launch::async, [&] {
+    return ahead.extract(texture(20), wallWithPerson(), 0.0, CameraModel());
+  });
+  for (int k = 0; k < kFrames; ++k) {
+    frontend::Extracted ex = next.get();
+    if (k + 1 < kFrames)
+      next = std::async(std::launch::async, [&, k] {
+        return ahead.extract(texture(21 + k), wallWithPerson(), (k + 1) / 30.0, CameraModel());
+      });
+    const frontend::FrontEndResult a = ahead.screen(std::move(ex), {personBox()}, CameraModel());
+    const frontend::FrontEndResult b =
+        serial.process(texture(20 + k), wallWithPerson(), k / 30.0, {personBox()}, CameraModel());
+    ASSERT_EQ(a.frame.size(), b.frame.size()) << "frame " << k;
+    EXPECT_EQ(a.frame.dynamic, b.frame.dynamic) << "frame " << k;
+    EXPECT_EQ(a.frame.depth, b.frame.depth) << "frame " << k;
+    EXPECT_GT(a.frame.countDynamic(), 20u) << "frame " << k;
+    EXPECT_EQ(a.boxes.size(), b.boxes.size()) << "frame " << k;
+    EXPECT_GT(a.stats.extraction_ms, 0.0);
+  }
+}
+
+TEST(FrontEnd, ExtractRefusesWhatProcessRefuses) {
+  const frontend::FrontEnd fe = makeFrontEnd(screening::DynamicMode::DetectGeometry);
+  EXPECT_THROW(fe.extract(cv::Mat(), wallWithPerson(), 0.0, CameraModel()), Error);
+  EXPECT_THROW(fe.extract(texture(1), cv::Mat(100, 100, CV_32F, cv::Scalar(2.0f)), 0.0, CameraModel()), Error);
 }

@@ -2,6 +2,7 @@
 // mismatched depth, empty images, timestamp jumps. Tracking reports lost (or not initialised),
 // never crashes and never outputs a non-finite pose.
 #include "yolo_slam/common/config.h"
+#include "yolo_slam/common/error.h"
 #include "yolo_slam/frontend/front_end.h"
 #include "yolo_slam/slam/system.h"
 
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 
 using namespace yolo_slam;
@@ -144,4 +146,45 @@ TEST(SlamSystem, TrackRgbdScreensThroughTheFrontEnd) {
     EXPECT_EQ(a.depth, b.depth) << "frame " << k;
     EXPECT_GT(std::count(a.dynamic.begin(), a.dynamic.end(), 1), 10) << "frame " << k;
   }
+}
+
+TEST(SlamSystem, FramesExtractedAheadOnAnotherThreadAreScreenedAsTrackRgbdScreensThem) {
+  // yolo_slam_run (not --sequential) extracts frame k+1 while frame k is screened and tracked.
+  const SystemOptions opt = SystemOptions::load(Config());
+  System serial(CameraModel(), opt, nullptr), ahead(CameraModel(), opt, nullptr);
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(3.0f));
+  const cv::Rect person(250, 100, 140, 320);
+  depth(person).setTo(1.3f);
+  detection::Box box;
+  box.rect = cv::Rect2f(person);
+  box.score = 0.9f;
+  const int kFrames = 4;
+  auto extractAsync = [&](int k) {
+    return std::async(std::launch::async, [&, k] { return ahead.extractFrame(texture(30 + k), depth, k / 30.0); });
+  };
+  std::future<ExtractedFrame> next = extractAsync(0);
+  for (int k = 0; k < kFrames; ++k) {
+    ExtractedFrame ef = next.get();
+    if (k + 1 < kFrames) next = extractAsync(k + 1);
+    const TrackResult a = ahead.trackExtracted(std::move(ef), {box});
+    const TrackResult b = serial.trackRgbd(texture(30 + k), depth, k / 30.0, {box});
+    EXPECT_EQ(a.state, b.state) << "frame " << k;
+    const features::FeatureFrame fa = ahead.lastFrame(), fb = serial.lastFrame();
+    ASSERT_EQ(fa.size(), fb.size()) << "frame " << k;
+    EXPECT_EQ(fa.dynamic, fb.dynamic) << "frame " << k;
+  }
+  EXPECT_EQ(ahead.stats().frames, static_cast<size_t>(kFrames));
+}
+
+TEST(SlamSystem, AFrameTheFrontEndRefusesAheadIsReportedLost) {
+  System sys(CameraModel(), offOptions(), nullptr);
+  const cv::Mat plane(480, 640, CV_32F, cv::Scalar(2.0f));
+  ExtractedFrame ef = sys.extractFrame(cv::Mat(), plane, 0.0);
+  EXPECT_NE(ef.error.find("empty image"), std::string::npos) << ef.error;
+  EXPECT_NE(sys.trackExtracted(std::move(ef), {}).state, TrackingState::Ok);
+  EXPECT_EQ(sys.trackExtracted(sys.extractFrame(texture(3), plane, 0.033), {}).state, TrackingState::Ok);
+  const SystemStats s = sys.stats();
+  EXPECT_EQ(s.frames, 2u);
+  EXPECT_EQ(s.lost, 1u);
+  EXPECT_THROW(sys.extractFrame(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(0)), plane, 0.066), Error);
 }

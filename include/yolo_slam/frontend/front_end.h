@@ -38,6 +38,16 @@ struct FrontEndResult {
   bool awaiting_detection = false;
 };
 
+// A frame extracted and not yet screened (FrontEnd::extract): a caller may extract the next
+// frame on another thread while this one is screened and tracked.
+struct Extracted {
+  features::FeatureFrame frame;  // keypoints and depth, nothing flagged dynamic yet
+  cv::Mat image;                 // the caller's image and cleaned depth (shared, not copied)
+  cv::Mat depth;
+  size_t budget_step = 0;        // extracted with nFeatures times 1 + 0.25 * budget_step
+  double extraction_ms = 0;
+};
+
 // One per camera stream: screening remembers tracked boxes and the previous frame.
 class FrontEnd {
  public:
@@ -51,6 +61,12 @@ class FrontEnd {
   // detector_ran false: no detection was made for this frame (asynchronous detection).
   FrontEndResult process(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                          const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran = true);
+  // process() in two halves. extract() checks and cleans the depth and extracts (throws as
+  // process()); it takes no lock and may run on another thread beside screen(). Its budget
+  // follows the newest frame screened before it starts: extracted one frame ahead, a frame is
+  // sized by the one two before it. screen() screens frames one at a time, in stream order.
+  Extracted extract(const cv::Mat& image, const cv::Mat& depth_m, double stamp, const CameraModel& cam) const;
+  FrontEndResult screen(Extracted ex, const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran = true);
   // Forgets tracked boxes and the previous frame (a new sequence or a map reset).
   void clear();
 
@@ -62,9 +78,12 @@ class FrontEnd {
   // frame's keypoints, the budget that would have left nFeatures (rounded up to a step, at
   // most dynamic_boost_max); else nFeatures.
   size_t budgetStep() const;
-  // Extraction with orb_[step], then screening (under mutex_); records the dropped share.
-  FrontEndResult extractAndScreen(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
-                                  const detection::Boxes& boxes, const CameraModel& cam, bool detector_ran);
+  // Extraction with orb_[step] (depth already cleaned).
+  Extracted extractWith(size_t step, const cv::Mat& image, const cv::Mat& depth, double stamp,
+                        const CameraModel& cam) const;
+  // Screening (under mutex_); records the dropped share.
+  FrontEndResult screenExtracted(Extracted ex, const detection::Boxes& boxes, const CameraModel& cam,
+                                 bool detector_ran);
 
   // nFeatures times 1, 1 + kBoostStep, ... up to dynamic_boost_max; const after construction
   // (thread-safe).

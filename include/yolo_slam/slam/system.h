@@ -119,6 +119,14 @@ struct SystemOptions {
   static SystemOptions load(const Config& cfg);
 };
 
+// A frame extracted ahead of its screening and tracking (System::extractFrame).
+struct ExtractedFrame {
+  frontend::Extracted extracted;
+  double stamp = 0;
+  cv::Mat image, depth_m;  // the caller's image and usable depth, for the dense map
+  std::string error;       // why the front end refused the frame (reported lost)
+};
+
 class System {
  public:
   // Reads the keys of SystemOptions from `cfg` (throws yolo_slam::Error naming the file and key
@@ -140,6 +148,13 @@ class System {
   // (asynchronous detection), so the box tracker carries every box.
   TrackResult trackRgbd(const cv::Mat& image, const cv::Mat& depth_m, double stamp,
                         const detection::Boxes& boxes, bool detector_ran = true);
+  // trackRgbd in two halves, so that a caller can extract the next frame on another thread
+  // while this one is screened and tracked (yolo_slam_run when not --sequential).
+  // extractFrame is safe beside trackExtracted; it throws as trackRgbd on an image of the wrong
+  // size and keeps other bad input in ExtractedFrame::error (the frame is then reported lost).
+  // trackExtracted takes the frames in stream order.
+  ExtractedFrame extractFrame(const cv::Mat& image, const cv::Mat& depth_m, double stamp);
+  TrackResult trackExtracted(ExtractedFrame frame, const detection::Boxes& boxes, bool detector_ran = true);
   // Already extracted and screened (ROS Slam nodelet). Keypoints flagged dynamic are ignored.
   TrackResult trackFeatures(const features::FeatureFrame& frame);
   // Dense map (DenseMap.enabled): hands the keyframe the last trackFeatures made, with the
@@ -214,6 +229,7 @@ class System {
   MapFileContext mapFileContext() const;
   // Sequential mode: local mapping, then loop closing, on what the last frame queued.
   void runBackEndInline();
+  frontend::FrontEnd& frontEnd();  // made on first use
 
   CameraModel cam_;
   SlamOptions opt_;
