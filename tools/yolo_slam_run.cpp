@@ -37,6 +37,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <map>
 #include <optional>
@@ -481,14 +482,6 @@ Prepared loadFrame(const RunSetup& r, size_t i) {
   return p;
 }
 
-// The worker's task: loads frame i and detects people in it (the detector is used by one task
-// at a time).
-Prepared prepareFrame(const RunSetup& r, size_t i) {
-  Prepared p = loadFrame(r, i);
-  if (p.has_image) detectInto(r, p);
-  return p;
-}
-
 // Why frames got no pose, for the summary of a run that tracked too little.
 struct UntrackedCounts {
   size_t no_image = 0;      // image missing or unreadable: the frame was skipped
@@ -521,12 +514,11 @@ std::vector<double> stampsOf(const RunSetup& setup, size_t count = SIZE_MAX) {
   return stamps;
 }
 
-// Frames in sequence order, each loaded (and, with every-frame detection, detected) in a
-// worker while the one before it is tracked; --realtime paces them at their stamps (gaps
-// capped, the wait ends on a stop signal).
+// Frames in sequence order, each loaded in a worker while the one before it goes through the
+// pipeline; --realtime paces them at their stamps (gaps capped, the wait ends on a stop signal).
 class PrefetchSource {
  public:
-  // `preloaded`: every frame already read (--preload); the worker then only detects.
+  // `preloaded`: every frame already read (--preload); the worker then only hands them over.
   PrefetchSource(const RunSetup& setup, bool realtime, std::vector<Prepared> preloaded = {})
       : setup_(setup), realtime_(realtime), preloaded_(std::move(preloaded)),
         wall0_(std::chrono::steady_clock::now()), offsets_(io::playbackSchedule(stampsOf(setup)).offsets) {
@@ -552,10 +544,8 @@ class PrefetchSource {
   void start(size_t i) {
     next_ = std::async(std::launch::async, [this, i] {
       nameThisThread("ys_load_frame");
-      if (i >= preloaded_.size()) return prepareFrame(setup_, i);
-      Prepared p = std::move(preloaded_[i]);
-      if (p.has_image) detectInto(setup_, p);
-      return p;
+      if (i >= preloaded_.size()) return loadFrame(setup_, i);
+      return std::move(preloaded_[i]);
     });
   }
   const RunSetup& setup_;
@@ -577,27 +567,23 @@ std::vector<Prepared> loadAllFrames(const RunSetup& setup, const char* why) {
   return frames;
 }
 
-// --camera-rate: frames as a live camera gives them (io::CameraFeed), newest wins. With
-// every-frame detection, a frame taken is detected before it is screened, as in a run at full
-// speed, but on the frame loop's thread: the camera does not detect.
+// --camera-rate: frames as a live camera gives them (io::CameraFeed), newest wins: a frame that
+// arrives while the pipeline's first stage (detection) is busy replaces the waiting one.
 class CameraSource {
  public:
   explicit CameraSource(const RunSetup& setup)
-      : setup_(setup),
-        frames_(loadAllFrames(setup, "--camera-rate")),
+      : frames_(loadAllFrames(setup, "--camera-rate")),
         feed_(stampsOf(setup, frames_.size()), [this](size_t i) { return std::move(frames_[i]); }) {}
   std::optional<Prepared> next() {
     std::optional<io::CameraFeed<Prepared>::Arrived> a = feed_.next(stopRequested);
     if (!a) return std::nullopt;
     a->frame.arrival = a->due;
-    if (a->frame.has_image) detectInto(setup_, a->frame);
     return std::move(a->frame);
   }
   long offered() const { return feed_.offered(); }
   long dropped() const { return feed_.dropped(); }
 
  private:
-  const RunSetup& setup_;
   std::vector<Prepared> frames_;  // each moved out once, by the camera thread
   io::CameraFeed<Prepared> feed_;
 };
@@ -730,19 +716,21 @@ void runFrameLoop(Source& source, const RunSetup& setup, slam::System& system, P
   bar.finish();
 }
 
-// Not --sequential: each frame is extracted on a worker while the frame before it is screened
-// and tracked (System::extractFrame), so the frame loop's thread does only screening and
-// tracking. The asynchronous detector is offered a frame by the frame loop, when the frame is
-// screened: Detection.asyncMaxLag counts frames screened.
+// One stage of the frame pipeline on a worker of its own: takes the frames of `source` in
+// order and does `work` on each frame with an image, one frame ahead of its caller.
 template <class Source>
-class ExtractAhead {
+class AheadStage {
  public:
-  ExtractAhead(Source& source, slam::System& system) : source_(source), system_(system) {
+  using Work = std::function<void(Prepared&)>;
+  AheadStage(Source& source, const char* thread_name, Work work)
+      : source_(source), thread_name_(thread_name), work_(std::move(work)) {
     start();
   }
-  ~ExtractAhead() {
+  ~AheadStage() {
     if (next_.valid()) next_.wait();
   }
+  AheadStage(const AheadStage&) = delete;
+  AheadStage& operator=(const AheadStage&) = delete;
   std::optional<Prepared> next() {
     std::optional<Prepared> p = next_.get();
     if (p) start();
@@ -752,27 +740,37 @@ class ExtractAhead {
  private:
   void start() {
     next_ = std::async(std::launch::async, [this] {
-      nameThisThread("ys_extract");
+      nameThisThread(thread_name_);
       std::optional<Prepared> p = source_.next();
-      if (!p || !p->has_image) return p;
-      p->extracted = system_.extractFrame(p->bgr, p->depth, p->stamp);
+      if (p && p->has_image) work_(*p);
       return p;
     });
   }
   Source& source_;
-  slam::System& system_;
+  const char* const thread_name_;
+  const Work work_;
   std::future<std::optional<Prepared>> next_;
 };
 
+// The pipeline's stages, each on its own worker: the source loads (or the camera hands over)
+// frame t+2 while frame t+1 is detected (every-frame detection, or boxes read from a file) and,
+// unless --sequential, frame t+1 is then extracted (System::extractFrame) while the frame loop
+// screens and tracks frame t. With --sequential the frame loop extracts, so the feature budget
+// follows the frame just screened and two runs are identical. The asynchronous detector is
+// offered a frame by the frame loop, when the frame is screened: Detection.asyncMaxLag counts
+// frames screened.
 template <class Source>
 void runFrames(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
                LoopResult& res) {
-  if (!system.sequential()) {
-    ExtractAhead<Source> ahead(source, system);
-    runFrameLoop(ahead, setup, system, outputs, res);
-  } else {
-    runFrameLoop(source, setup, system, outputs, res);
+  AheadStage<Source> detect(source, "ys_detect_frame", [&setup](Prepared& p) { detectInto(setup, p); });
+  if (system.sequential()) {
+    runFrameLoop(detect, setup, system, outputs, res);
+    return;
   }
+  AheadStage<AheadStage<Source>> extract(detect, "ys_extract", [&system](Prepared& p) {
+    p.extracted = system.extractFrame(p.bgr, p.depth, p.stamp);
+  });
+  runFrameLoop(extract, setup, system, outputs, res);
 }
 
 LoopResult processFrames(const Args& args, const RunSetup& setup, slam::System& system, PartialOutputs& outputs) {
