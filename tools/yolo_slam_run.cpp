@@ -339,7 +339,7 @@ struct Prepared {
   std::string mask_path;
   std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
   bool detector_ran = true;  // false: async detection had no new result for this frame
-  std::optional<slam::ExtractedFrame> extracted;  // extracted ahead (ExtractAhead)
+  std::optional<slam::ExtractedFrame> extracted;  // extracted ahead (the extraction stage, not --sequential)
 };
 
 std::string baseName(const std::string& path) {
