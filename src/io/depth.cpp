@@ -2,6 +2,7 @@
 
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/common/paths.h"
+#include "yolo_slam/io/image_file.h"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -75,7 +76,7 @@ cv::Mat decodeDepth(const cv::Mat& raw, double depth_map_factor, const std::stri
 cv::Mat loadDepth(const std::string& path, double depth_map_factor) {
   if (dirExists(path)) throw Error(path + ": is a folder, expected a depth image file; fix depth.txt or associations.txt");
   if (!fileExists(path)) throw Error(path + ": depth image not found");
-  cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  cv::Mat raw = readImage(path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw Error(path + ": cannot decode depth image (corrupt or unsupported format)");
   DepthCounts n;
   cv::Mat depth = decodeDepth(raw, depth_map_factor, path, kNoDepthLimit, &n);

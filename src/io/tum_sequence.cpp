@@ -6,6 +6,7 @@
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/io/association.h"
 #include "yolo_slam/io/depth.h"
+#include "yolo_slam/io/image_file.h"
 #include "yolo_slam/io/text_table.h"
 #include "yolo_slam/io/trajectory.h"
 
@@ -120,7 +121,7 @@ cv::Mat TumSequence::loadRgb(size_t i) const {
   const std::string& path = frame(i).rgb_path;
   if (dirExists(path)) throw Error(path + ": is a folder, expected an rgb image file; fix its line in rgb.txt or associations.txt");
   if (!fileExists(path)) throw Error(path + ": rgb image not found");
-  cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
+  cv::Mat img = readImage(path, cv::IMREAD_COLOR);
   if (img.empty()) throw Error(path + ": cannot decode rgb image (corrupt or unsupported format)");
   return img;
 }
