@@ -1,6 +1,8 @@
 #include "yolo_slam/common/paths.h"
 #include "yolo_slam/io/image_file.h"
 
+#include "support/mutate.h"
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -268,6 +270,83 @@ TEST(ImageFile, DoubtfulPngsAreLeftToOpenCv) {
   EXPECT_FALSE(io::decodePlainPng(depth.data(), depth.size(), cv::IMREAD_COLOR, &out))
       << "16-bit read as colour is OpenCV's conversion";
   expectReadsAsImread(depth, "depth_as_colour.png", cv::IMREAD_COLOR);
+}
+
+namespace {
+
+// Every chunk's CRC rewritten, so that a mutant gets past the checksums to the parser behind.
+std::vector<uint8_t> withValidCrcs(std::vector<uint8_t> png) {
+  size_t at = 8;
+  while (png.size() >= at + 12) {
+    const uint32_t length = (uint32_t(png[at]) << 24) | (png[at + 1] << 16) | (png[at + 2] << 8) | png[at + 3];
+    if (length > png.size() - at - 12) break;
+    const uint32_t crc = libdeflate_crc32(0, &png[at + 4], length + 4);
+    for (int i = 0; i < 4; ++i) png[at + 8 + length + i] = uint8_t(crc >> (24 - 8 * i));
+    at += 12 + length;
+  }
+  return png;
+}
+
+cv::Mat openCvDecode(const std::vector<uint8_t>& bytes, int flags) {
+  try {
+    return bytes.empty() ? cv::Mat() : cv::imdecode(bytes, flags);
+  } catch (const cv::Exception&) {
+    return cv::Mat();
+  }
+}
+
+}  // namespace
+
+// Differential fuzzing: mutants (their CRCs made valid again) that the fast path accepts decode to
+// OpenCV's pixels; the rest are refused without a crash and go to OpenCV.
+TEST(ImageFile, MutantsPastTheChecksumsDecodeAsOpenCvDecodesThem) {
+  const int w = 13, h = 7;
+  const std::vector<std::vector<uint8_t>> valid = {handPng(w, randomRows(w, h, 3, 21), 8, 2, {0, 1, 2, 3, 4}),
+                                                   handPng(w, randomRows(w, h, 2, 22), 16, 0, {4, 3, 2, 1, 0})};
+  test_support::Mutator mutator(28);
+  const int n = test_support::fuzzIterations(400);
+  int accepted = 0;
+  ::testing::internal::CaptureStderr();  // libpng's messages about the mutants
+  for (int i = 0; i < n; ++i) {
+    const auto& v = valid[i % valid.size()];
+    const std::string m = mutator.mutate(std::string(v.begin(), v.end()));
+    const std::vector<uint8_t> mutant = withValidCrcs(std::vector<uint8_t>(m.begin(), m.end()));
+    const int flags = i % 2 ? cv::IMREAD_UNCHANGED : cv::IMREAD_COLOR;
+    cv::Mat fast;
+    if (!io::decodePlainPng(mutant.data(), mutant.size(), flags, &fast)) continue;
+    ++accepted;
+    EXPECT_TRUE(identical(fast, openCvDecode(mutant, flags))) << "mutant " << i;
+  }
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_GT(accepted, 0) << "no mutant reached the decoder";
+  EXPECT_LT(accepted, n) << "no mutant was refused";
+}
+
+// Random row data and filter bytes (5-7 are invalid): the fast path decodes exactly what OpenCV
+// decodes, and refuses what OpenCV refuses.
+TEST(ImageFile, RandomRowsAndFilterBytesDecodeAsOpenCvDecodesThem) {
+  std::mt19937 rng(5);
+  const int n = test_support::fuzzIterations(400);
+  int accepted = 0;
+  ::testing::internal::CaptureStderr();
+  for (int i = 0; i < n; ++i) {
+    const Layout& l = kLayouts[i % (sizeof kLayouts / sizeof kLayouts[0])];
+    const int w = 1 + int(rng() % 40), h = 1 + int(rng() % 12);
+    std::vector<int> filters(h);
+    for (auto& f : filters) f = rng() % 16 == 0 ? 5 + int(rng() % 3) : int(rng() % 5);
+    const std::vector<uint8_t> png = handPng(w, randomRows(w, h, l.bpp, rng()), l.depth, l.colour, filters);
+    cv::Mat fast;
+    const bool ok = io::decodePlainPng(png.data(), png.size(), l.flags, &fast);
+    const cv::Mat viaOpenCv = openCvDecode(png, l.flags);
+    EXPECT_EQ(ok, !viaOpenCv.empty()) << "case " << i;
+    if (ok) {
+      ++accepted;
+      EXPECT_TRUE(identical(fast, viaOpenCv)) << "case " << i;
+    }
+  }
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_GT(accepted, n / 3);
+  EXPECT_LT(accepted, n);
 }
 
 #endif
