@@ -17,22 +17,27 @@ namespace yolo_slam {
 namespace io {
 namespace {
 
-// The whole file into `bytes` (empty when it cannot be read).
-void readBytes(const std::string& path, std::vector<uint8_t>& bytes) {
+// Files larger than this are left to cv::imread, which reads only what it needs of them.
+constexpr std::streamoff kMaxBufferedFile = std::streamoff(1) << 30;
+
+// The whole file into `bytes`; false when it cannot be opened or read, is empty or too large.
+bool readBytes(const std::string& path, std::vector<uint8_t>& bytes) {
   bytes.clear();
   std::ifstream f(path, std::ios::binary | std::ios::ate);
   const std::streamoff size = f ? std::streamoff(f.tellg()) : std::streamoff(0);
-  if (size <= 0) return;
+  if (size <= 0 || size > kMaxBufferedFile) return false;
   bytes.resize(static_cast<size_t>(size));
   f.seekg(0);
-  if (!f.read(reinterpret_cast<char*>(bytes.data()), size)) bytes.clear();
+  if (f.read(reinterpret_cast<char*>(bytes.data()), size)) return true;
+  bytes.clear();
+  return false;
 }
 
-cv::Mat decodeWithOpenCv(const std::vector<uint8_t>& bytes, int flags) {
-  if (bytes.empty()) return cv::Mat();
+// OpenCV's decoders report most failures with an empty Mat, some by throwing: both are empty here.
+template <typename Decode>
+cv::Mat emptyOnException(Decode decode) {
   try {
-    return cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<uint8_t*>(bytes.data())),
-                        flags);
+    return decode();
   } catch (const cv::Exception&) {
     return cv::Mat();
   }
@@ -43,10 +48,11 @@ cv::Mat decodeWithOpenCv(const std::vector<uint8_t>& bytes, int flags) {
 cv::Mat readImage(const std::string& path, int flags) {
   // Buffers reused from image to image: a frame's megabyte is not allocated and faulted in anew.
   thread_local std::vector<uint8_t> bytes;
-  readBytes(path, bytes);
+  if (!readBytes(path, bytes)) return emptyOnException([&] { return cv::imread(path, flags); });
   cv::Mat out;
   if (decodePlainPng(bytes.data(), bytes.size(), flags, &out)) return out;
-  return decodeWithOpenCv(bytes, flags);
+  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data());
+  return emptyOnException([&] { return cv::imdecode(encoded, flags); });
 }
 
 #ifndef YOLO_SLAM_HAVE_LIBDEFLATE
