@@ -5,7 +5,7 @@ the latency from image stamp to published pose, frames dropped, and the ATE.
 usage: bench/ros_realtime.py SEQ_DIR [--bag BAG] [--rate 1.0] [--out DIR] [--launch-arg k:=v ...]
 
 SEQ_DIR is a TUM folder with groundtruth.txt (yolo_slam_synth output); the bag is made from it
-with scripts/tum_to_bag.py unless --bag names one. Runs `roslaunch yolo_slam tum_bag.launch`
+with scripts/tum_to_bag.py (as OUT/sequence.bag, or as --bag when that file does not exist yet). Runs `roslaunch yolo_slam tum_bag.launch`
 (source build/ws/devel/setup.bash first), reads /diagnostics until playback has ended and the
 graph has drained, saves the trajectory through /yolo_slam/save_trajectory and evaluates it
 with yolo_slam_eval. Prints one JSON object (also written to OUT/ros_realtime.json).
@@ -55,7 +55,7 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     bag = a.bag or os.path.join(a.out, "sequence.bag")
-    if not a.bag and not os.path.exists(bag):
+    if not os.path.exists(bag):
         subprocess.check_call([os.path.join(REPO, "scripts", "tum_to_bag.py"), a.seq, bag])
     frames = frames_in(a.seq)
     traj = os.path.join(a.out, "CameraTrajectory.txt")
@@ -98,6 +98,10 @@ def main():
         last_received, last_change = -1, time.time()
         while time.time() < deadline:
             time.sleep(0.5)
+            if launch.poll() is not None:
+                sys.stderr.write("ros_realtime: the launch ended early (exit %d); see %s\n"
+                                 % (launch.returncode, os.path.join(a.out, "launch.log")))
+                break
             received = int(slam_diag().get("received", "0"))
             if received != last_received:
                 last_received, last_change = received, time.time()
