@@ -6,7 +6,8 @@
 // tracker carries boxes in between. With Detection.async 0 colour, depth and boxes are
 // synchronised (every frame waits for its detection, the paper's pipeline). Frames the
 // synchroniser drops are counted (never silent): a warning per drop burst and a /diagnostics
-// status every second.
+// status every second. Until both images have arrived once, a warning every ~input_timeout
+// seconds names the topic that stays silent (wrong topic names, or no camera driver).
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <dynamic_reconfigure/server.h>
@@ -59,6 +60,7 @@ class ScreeningNodelet : public nodelet::Nodelet {
     double max_interval = 0.05;
     pnh.param("sync_max_interval", max_interval, 0.05);
     pnh.param("sync_min_period", sync_min_period_, kDefaultSyncMinPeriodS);
+    pnh.param("input_timeout", input_timeout_s_, kDefaultInputTimeoutS);
     try {
       const Config cfg = loadSettings(pnh);
       const bool rectified = rectifiedInput(pnh, nh.resolveName(kRgbTopic));
@@ -99,6 +101,10 @@ class ScreeningNodelet : public nodelet::Nodelet {
     rgb_sub_.subscribe(nh, kRgbTopic, queue_size);
     depth_sub_.subscribe(nh, kDepthTopic, queue_size);
     rgb_sub_.registerCallback(&ScreeningNodelet::onRgbArrived, this);
+    depth_sub_.registerCallback(&ScreeningNodelet::onDepthArrived, this);
+    if (input_timeout_s_ > 0)
+      input_watch_ = nh.createWallTimer(::ros::WallDuration(input_timeout_s_),
+                                        [this](const ::ros::WallTimerEvent&) { warnIfNoInput(); });
     if (async_boxes_) {
       // Multi-threaded handle: boxes are stored while a frame is being processed.
       async_boxes_sub_ = getMTNodeHandle().subscribe("yolo_slam/boxes", kBoxesQueue, &ScreeningNodelet::onBoxes, this);
@@ -153,6 +159,32 @@ class ScreeningNodelet : public nodelet::Nodelet {
     ++rgb_received_;
     pending_rgb_.push_back(img->header.stamp);
     if (pending_rgb_.size() > 10000) pending_rgb_.pop_front();
+  }
+
+  void onDepthArrived(const ImageConstPtr&) { depth_arrived_ = true; }
+
+  // Before the first colour and depth image: which topic is silent, and who publishes it.
+  void warnIfNoInput() {
+    size_t rgb = 0;
+    {
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      rgb = rgb_received_;
+    }
+    const bool depth = depth_arrived_;
+    if (rgb > 0 && depth) {
+      input_watch_.stop();
+      return;
+    }
+    silent_s_ += input_timeout_s_;
+    std::string silent;
+    for (const auto* sub : {rgb > 0 ? nullptr : &rgb_sub_, depth ? nullptr : &depth_sub_}) {
+      if (!sub) continue;
+      if (!silent.empty()) silent += " and ";
+      const ::ros::Subscriber& raw = sub->getSubscriber();
+      silent += raw.getTopic() + " (" + std::to_string(raw.getNumPublishers()) + " publishers)";
+    }
+    NODELET_WARN("Screening: no image on %s in %.0f s: check that the camera driver or bag publishes "
+                 "there (rostopic list), or remap with rgb_topic:= / depth_topic:=", silent.c_str(), silent_s_);
   }
 
   void onFrame2(const ImageConstPtr& rgb, const ImageConstPtr& depth) {
@@ -335,6 +367,12 @@ class ScreeningNodelet : public nodelet::Nodelet {
   // Colour and depth come at least this far apart (seconds): true of every camera up to 50 Hz.
   static constexpr double kDefaultSyncMinPeriodS = 0.02;
   double sync_min_period_ = kDefaultSyncMinPeriodS;  // ~sync_min_period, const after onInit
+  // ~input_timeout: seconds without the first colour or depth image between warnings (0: none).
+  static constexpr double kDefaultInputTimeoutS = 10.0;
+  double input_timeout_s_ = kDefaultInputTimeoutS;
+  ::ros::WallTimer input_watch_;  // warnIfNoInput, on the nodelet's queue
+  double silent_s_ = 0;           // warnIfNoInput only
+  std::atomic<bool> depth_arrived_{false};
   static constexpr double kAwaitMaxS = 2.0;         // longest wait for the first detection
   static constexpr size_t kTimingWindow = 1000;     // timing samples kept for diagnostics
   bool use_boxes_ = true, use_camera_info_ = true;
