@@ -1,34 +1,21 @@
 // scripts/play_bag.py (tum_bag.launch's player): a bag that cannot feed the graph ends the launch
 // with the file and the fix, before rosbag play starts. Runs in the repository root (the tests'
 // directory); the bags are written with the rosbag Python module, and those tests skip without it.
+#include "shell.h"
+
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
-#include <sys/wait.h>
+#include <unistd.h>
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Result {
-  int exit_code = -1;
-  std::string out;  // stdout and stderr
-};
-
-Result shell(const std::string& cmd) {
-  Result r;
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof(buf), p)) r.out += buf;
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using robustness::shell;
+using Result = robustness::ShellResult;
 
 Result playBag(const std::string& args) { return shell("/usr/bin/python3 scripts/play_bag.py " + args); }
 

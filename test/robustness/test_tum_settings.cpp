@@ -1,29 +1,18 @@
 // scripts/tum_settings.py (tum_bag.launch tum:=auto): a TUM camera's intrinsics pick its settings
 // file, the ROS default intrinsics of the official bags are resolved by the bag's name, and an
 // unknown camera fails naming its intrinsics. Runs in the repository root (the tests' directory).
+#include "shell.h"
+
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <string>
-
-#include <sys/wait.h>
 
 namespace {
 
-struct Result {
-  int exit_code = -1;
-  std::string out;  // stdout and stderr
-};
+using Result = robustness::ShellResult;
 
 Result tumSettings(const std::string& args) {
-  Result r;
-  FILE* p = ::popen(("/usr/bin/python3 scripts/tum_settings.py " + args + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof(buf), p)) r.out += buf;
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return robustness::shell("/usr/bin/python3 scripts/tum_settings.py " + args);
 }
 
 bool endsWith(const std::string& s, const std::string& tail) {
