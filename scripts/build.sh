@@ -16,6 +16,10 @@ mkdir -p "$YS_WS/.src"
 # A workspace configured with the older visible src/ layout is rebuilt from scratch.
 if [ -e "$YS_WS/src" ]; then rm -rf "$YS_WS/src" "$YS_WS/build" "$YS_WS/devel"; fi
 
+# `scripts/build.sh install` fills build/ws/.install: hidden for the same reason, as a visible
+# install space inside the repository would hold a second copy of every launch file for
+# roslaunch to find ("multiple files named tum_bag.launch").
 cd "$YS_WS"
 catkin_make --source .src -j2 -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" \
+  -DCMAKE_INSTALL_PREFIX="$YS_WS/.install" \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
