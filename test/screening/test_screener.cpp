@@ -1,9 +1,11 @@
 // Algorithm 1 on constructed depth sets, the adaptive k of Eq. 8, determinism and modes.
 #include "yolo_slam/common/config.h"
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/features/orb_extractor.h"
 #include "yolo_slam/screening/screener.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -389,6 +391,37 @@ TEST(Metrics, StaticKeypointsOnAPersonsOutlineAreCountedApart) {
   const Json j(m);
   EXPECT_EQ(j["static_on_outline"], 3) << j.dump();
   EXPECT_DOUBLE_EQ(j["static_drop_rate_off_outline"].get<double>(), 0.5);
+}
+
+// The outline test reads a disc around each keypoint; its definition is the Euclidean distance
+// to the nearest dynamic pixel, which cv::distanceTransform gives for the whole mask.
+TEST(Metrics, OutlineTestAgreesWithTheDistanceTransform) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  cv::Mat mask(60, 80, CV_8UC1, cv::Scalar(0));
+  for (int i = 0; i < 6; ++i)  // scattered blobs and single pixels, some on the border
+    mask.at<uint8_t>(int(u(rng) * 60), int(u(rng) * 80)) = 255;
+  mask(cv::Rect(30, 20, 7, 5)).setTo(200);
+  mask(cv::Rect(0, 50, 4, 10)).setTo(255);
+  cv::Mat to_dynamic;
+  cv::distanceTransform(mask <= 127, to_dynamic, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  features::FeatureFrame f;
+  f.width = mask.cols;
+  f.height = mask.rows;
+  int expected = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const int x = int(u(rng) * mask.cols), y = int(u(rng) * mask.rows);
+    if (mask.at<uint8_t>(y, x) > 127) continue;
+    const float size = 31.f * std::pow(1.2f, float(i % 8));
+    f.keypoints.emplace_back(cv::Point2f(float(x), float(y)), size);
+    const double r = features::OrbExtractor::kFastRadius * features::OrbExtractor::levelScale(f.keypoints.back());
+    expected += to_dynamic.at<float>(y, x) <= r ? 1 : 0;
+  }
+  f.dynamic.assign(f.keypoints.size(), 0);
+  const ScreeningMetrics m = evaluateScreening(f, mask, {});
+  EXPECT_EQ(m.static_total, static_cast<int>(f.keypoints.size()));
+  EXPECT_GT(expected, 100);
+  EXPECT_EQ(m.static_on_outline, expected);
 }
 
 TEST(NearestVariant, PersonIsTheNearestClusterWhenTheBackgroundDominatesTheBox) {
