@@ -30,6 +30,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -114,7 +115,9 @@ const char* kUsage =
     "OUT/CameraTrajectory.txt (every tracked frame, TUM format), OUT/KeyFrameTrajectory.txt and\n"
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
     "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
-    "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). On a synthetic sequence\n"
+    "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). OUT/frames.txt has a\n"
+    "line per frame: state, inliers, keypoints, dynamic ones, boxes, whether the detector saw\n"
+    "it, keyframe, and the frame's screening counts against its mask. On a synthetic sequence\n"
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
     "keypoints on the masks of people (person_recall) and of every moving object\n"
     "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
@@ -618,15 +621,44 @@ std::string screenedBoxLines(double stamp, const detection::Boxes& boxes) {
 }
 
 // Retention counts static keypoints inside the boxes this run used (none in modes off and
-// geometry); exact synthetic masks need no ignored border.
-void evaluateFrame(const slam::System& system, const Prepared& p, MetricsAccumulator& metrics) {
-  if (p.mask.empty()) return;
+// geometry); exact synthetic masks need no ignored border. The frame's metrics, none without a
+// mask.
+std::optional<screening::ScreeningMetrics> evaluateFrame(const slam::System& system, const Prepared& p,
+                                                         MetricsAccumulator& metrics) {
+  if (p.mask.empty()) return std::nullopt;
   try {
-    metrics.sum += screening::evaluateScreening(system.lastFrame(), p.mask, system.lastBoxes(), 0);
+    const screening::ScreeningMetrics m =
+        screening::evaluateScreening(system.lastFrame(), p.mask, system.lastBoxes(), 0);
+    metrics.sum += m;
     ++metrics.frames;
+    return m;
   } catch (const Error& e) {
     std::fprintf(stderr, "\nwarning: %s: %s (frame not evaluated)\n", p.mask_path.c_str(), e.what());
+    return std::nullopt;
   }
+}
+
+const char* kFramesHeader =
+    "# rgb_stamp index state inliers keypoints dynamic boxes detected keyframe person_keypoints "
+    "person_dropped static_keypoints static_dropped\n";
+
+// One line of frames.txt: how tracking and screening went in this frame, to find where a run
+// went wrong (the four screening counts are -1 without a ground-truth mask).
+std::string frameLine(const Prepared& p, const char* state, const slam::TrackResult* r,
+                      const slam::System* system, const std::optional<screening::ScreeningMetrics>& m) {
+  long keypoints = 0, dynamic = 0, boxes = 0;
+  if (system) {
+    const features::FeatureFrame& f = system->lastFrame();
+    keypoints = static_cast<long>(f.keypoints.size());
+    dynamic = static_cast<long>(std::count_if(f.dynamic.begin(), f.dynamic.end(), [](auto d) { return d != 0; }));
+    boxes = static_cast<long>(system->lastBoxes().size());
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %d %d %d %d %d %d\n", p.stamp, p.index, state,
+                r ? r->inliers : 0, keypoints, dynamic, boxes, p.detector_ran && system ? 1 : 0,
+                r && r->keyframe_inserted ? 1 : 0, m ? m->person_total : -1, m ? m->person_dropped : -1,
+                m ? m->static_total : -1, m ? m->static_dropped : -1);
+  return line;
 }
 
 // Async detection: offers the frame to the detector and screens it with the newest result if
@@ -652,6 +684,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
 struct PartialOutputs {
   std::unique_ptr<io::IncrementalFile> trajectory;
   std::unique_ptr<io::IncrementalFile> boxes;  // modes with detection only
+  std::unique_ptr<io::IncrementalFile> frames;
 };
 
 bool depthUnusable(const Prepared& p) {
@@ -680,6 +713,7 @@ void trackFrame(slam::System& system, Prepared& p, PartialOutputs& outputs, Loop
   if (!p.has_image) {
     ++res.skipped;
     ++res.untracked.no_image;
+    outputs.frames->append(frameLine(p, "no_image", nullptr, nullptr, std::nullopt));
     return;
   }
   const slam::TrackResult r = p.extracted ? system.trackExtracted(std::move(*p.extracted), p.boxes, p.detector_ran)
@@ -692,7 +726,8 @@ void trackFrame(slam::System& system, Prepared& p, PartialOutputs& outputs, Loop
   }
   ++res.processed;
   if (outputs.boxes) outputs.boxes->append(screenedBoxLines(p.stamp, system.lastBoxes()));
-  evaluateFrame(system, p, res.metrics);
+  const std::optional<screening::ScreeningMetrics> m = evaluateFrame(system, p, res.metrics);
+  outputs.frames->append(frameLine(p, slam::toString(r.state), &r, &system, m));
 }
 
 template <class Source>
@@ -909,10 +944,11 @@ Json runningStatsJson(const Args& args) {
 
 // Which files belong to this run (written before stats.json; paths relative to OUT, the map
 // as given).
-Json runFilesJson(const Args& args, bool boxes_written) {
+Json runFilesJson(const Args& args, bool boxes_written, bool frames_written) {
   return Json{{"camera_trajectory", io::RunFiles::kCameraTrajectory},
               {"keyframe_trajectory", io::RunFiles::kKeyFrameTrajectory},
               {"boxes_screened", boxes_written ? Json(io::RunFiles::kBoxesScreened) : Json(nullptr)},
+              {"frames", frames_written ? Json(io::RunFiles::kFrames) : Json(nullptr)},
               {"map", args.save_map.empty() ? Json(nullptr) : Json(args.save_map)}};
 }
 
@@ -927,6 +963,7 @@ PartialOutputs claimRunFolder(const Args& args, const RunSetup& setup) {
   if (setup.stages.detection)
     p.boxes = std::make_unique<io::IncrementalFile>(joinPath(args.out, io::RunFiles::kPartialBoxes),
                                                     "# rgb_stamp index label x1 y1 x2 y2 score tracked\n");
+  p.frames = std::make_unique<io::IncrementalFile>(joinPath(args.out, io::RunFiles::kPartialFrames), kFramesHeader);
   return p;
 }
 
@@ -939,6 +976,7 @@ struct FinalStats {
   const slam::SystemStats& s;
   const MapFiles& maps;
   bool boxes_written;
+  bool frames_written;
 };
 
 Json trackingJson(const Args& args, const FinalStats& f) {
@@ -954,7 +992,7 @@ Json runStatsJson(const Args& args, const RunSetup& setup, const FinalStats& f) 
   Json j{{"complete", f.outcome.complete()},
          {"status", f.outcome.status},
          {"reason", f.outcome.reason},
-         {"files", runFilesJson(args, f.boxes_written)},
+         {"files", runFilesJson(args, f.boxes_written, f.frames_written)},
          {"sequence", args.sequence},
          {"config", args.config},
          {"dynamic_mode", screening::toString(setup.options.screening.mode)},
@@ -1049,6 +1087,7 @@ int finishRun(const Args& args, const RunSetup& setup, slam::System& system, Par
   io::writeTrajectory(joinPath(args.out, io::RunFiles::kCameraTrajectory), traj);
   io::writeTrajectory(joinPath(args.out, io::RunFiles::kKeyFrameTrajectory), system.keyframeTrajectory());
   const bool boxes_written = outputs.boxes && outputs.boxes->finishAs(joinPath(args.out, io::RunFiles::kBoxesScreened));
+  const bool frames_written = outputs.frames->finishAs(joinPath(args.out, io::RunFiles::kFrames));
   if (!args.save_map.empty()) {
     maps.saved = system.saveMap(args.save_map);
     std::printf("saved map %s: %zu keyframes, %zu points, %zu bytes in %.0f ms\n", args.save_map.c_str(),
@@ -1058,15 +1097,16 @@ int finishRun(const Args& args, const RunSetup& setup, slam::System& system, Par
   const AteSummary ate = ateOf(setup.seq, traj);
   const slam::SystemStats s = system.stats();
   const Outcome outcome = outcomeOf(args, res, s);
-  const FinalStats stats{outcome, res, traj.size(), ate, s, maps, boxes_written};
+  const FinalStats stats{outcome, res, traj.size(), ate, s, maps, boxes_written, frames_written};
   Json stats_json = runStatsJson(args, setup, stats);
   if (!dense.is_null()) stats_json["dense_map"] = dense;
   io::writeFileAtomic(joinPath(args.out, io::RunFiles::kStats), dumpJson(stats_json));
   outputs.trajectory->remove();
   printSummary(setup, res, ate, s);
   const std::string boxes_name = boxes_written ? std::string(io::RunFiles::kBoxesScreened) + "," : "";
-  std::printf("wrote %s/{%s,%s,%s%s}\n", args.out.c_str(), io::RunFiles::kCameraTrajectory,
-              io::RunFiles::kKeyFrameTrajectory, boxes_name.c_str(), io::RunFiles::kStats);
+  const std::string frames_name = frames_written ? std::string(io::RunFiles::kFrames) + "," : "";
+  std::printf("wrote %s/{%s,%s,%s%s%s}\n", args.out.c_str(), io::RunFiles::kCameraTrajectory,
+              io::RunFiles::kKeyFrameTrajectory, boxes_name.c_str(), frames_name.c_str(), io::RunFiles::kStats);
   if (outcome.exit_code == kExitTooFewTracked)
     std::fprintf(stderr, "error: %s; everything is written to %s (exit code %d; --min-tracked 0 accepts such a run)\n",
                  outcome.reason.c_str(), args.out.c_str(), kExitTooFewTracked);

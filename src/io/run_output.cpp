@@ -18,7 +18,8 @@ namespace io {
 namespace fs = std::filesystem;
 
 std::vector<std::string> RunFiles::all() {
-  return {kCameraTrajectory, kKeyFrameTrajectory, kBoxesScreened, kStats, kPartialTrajectory, kPartialBoxes};
+  return {kCameraTrajectory, kKeyFrameTrajectory, kBoxesScreened, kFrames,
+          kStats, kPartialTrajectory, kPartialBoxes, kPartialFrames};
 }
 
 namespace {

@@ -76,8 +76,10 @@ TEST_F(RunOutputs, AFinishedRunLeavesExactlyItsFilesAndSaysComplete) {
     std::ofstream(joinPath(out, stale)) << "# from an earlier run\n";
   std::string err;
   ASSERT_EQ(runTool(runArgs(seq_, out), tree_->path("complete"), err), 0) << err;
-  EXPECT_EQ(filesIn(out), (std::vector<std::string>{"CameraTrajectory.txt", "KeyFrameTrajectory.txt", "stats.json"}));
+  EXPECT_EQ(filesIn(out), (std::vector<std::string>{"CameraTrajectory.txt", "KeyFrameTrajectory.txt", "frames.txt",
+                                                    "stats.json"}));
   const Json js = statsOf(out);
+  EXPECT_EQ(js["files"]["frames"], "frames.txt") << js.dump();
   EXPECT_EQ(js["complete"], true) << js.dump();
   EXPECT_EQ(js["status"], "finished") << js.dump();
   EXPECT_EQ(js["files"]["camera_trajectory"], "CameraTrajectory.txt") << js.dump();
@@ -95,7 +97,8 @@ TEST_F(RunOutputs, ScreenedBoxesAreRenamedIntoPlaceAtTheEnd) {
       0)
       << err;
   EXPECT_EQ(filesIn(out), (std::vector<std::string>{"CameraTrajectory.txt", "KeyFrameTrajectory.txt",
-                                                    "boxes_screened.txt", "stats.json"}));
+                                                    "boxes_screened.txt", "frames.txt", "stats.json"}));
   EXPECT_EQ(readAll(joinPath(out, "boxes_screened.txt")).rfind("# rgb_stamp index label", 0), 0u);
   EXPECT_EQ(statsOf(out)["files"]["boxes_screened"], "boxes_screened.txt");
 }
+

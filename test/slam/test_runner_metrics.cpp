@@ -163,6 +163,47 @@ TEST_F(RunnerMetrics, GroundTruthBoxesGiveHighRecall) {
   EXPECT_EQ(lineCount(joinPath(out, "CameraTrajectory.txt")), numberOf(js, "trajectory_poses"));
 }
 
+// frames.txt: one line per frame read, in order, with the tracking state and, on a synthetic
+// sequence, the screening counts of the frame's ground-truth mask.
+TEST_F(RunnerMetrics, FramesFileHasALinePerFrame) {
+  const std::string out = joinPath(dir_, "out_frames");
+  std::string so, se;
+  ASSERT_EQ(runTool({"--sequence", seq(), "--out", out, "--boxes-from-gt", "--sequential"}, joinPath(dir_, "frames"),
+                    so, se),
+            0)
+      << so << se;
+  std::istringstream in(readAll(joinPath(out, "frames.txt")));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind("# rgb_stamp index state inliers", 0), 0u) << line;
+  size_t n = 0, ok = 0;
+  long persons = 0, persons_dropped = 0;
+  while (std::getline(in, line)) {
+    std::istringstream is(line);
+    double stamp = 0;
+    size_t index = 0;
+    std::string state;
+    long v[10];
+    ASSERT_TRUE(is >> stamp >> index >> state) << line;
+    for (long& x : v) ASSERT_TRUE(is >> x) << line;
+    EXPECT_EQ(index, n) << line;
+    EXPECT_TRUE(state == "ok" || state == "lost" || state == "not_initialized") << line;
+    ok += state == "ok" ? 1 : 0;
+    EXPECT_GE(v[1], v[2]) << "dynamic keypoints are keypoints: " << line;
+    EXPECT_GE(v[6], 0) << "the synthetic sequence has masks: " << line;
+    persons += v[6];
+    persons_dropped += v[7];
+    ++n;
+  }
+  EXPECT_EQ(static_cast<int>(n), kFrames);
+  const Json js = statsOf(out);
+  EXPECT_EQ(js["files"]["frames"], "frames.txt") << js.dump();
+  EXPECT_GT(persons_dropped, 0);
+  EXPECT_EQ(static_cast<long>(ok), js["tracked"].get<long>()) << js.dump();
+  EXPECT_EQ(persons, js["screening_metrics"]["person_keypoints"].get<long>()) << js.dump();
+  EXPECT_EQ(persons_dropped, js["screening_metrics"]["person_dropped"].get<long>()) << js.dump();
+}
+
 // The detector's rows of a boxes_screened.txt (tracked 0), with the header dropped.
 static std::vector<std::string> detectedRows(const std::string& path) {
   std::vector<std::string> rows;

@@ -15,10 +15,13 @@ struct RunFiles {
   static constexpr const char* kCameraTrajectory = "CameraTrajectory.txt";
   static constexpr const char* kKeyFrameTrajectory = "KeyFrameTrajectory.txt";
   static constexpr const char* kBoxesScreened = "boxes_screened.txt";
+  static constexpr const char* kFrames = "frames.txt";
   static constexpr const char* kStats = "stats.json";
-  // Grown while the run goes on: tracking poses as estimated, boxes as screened.
+  // Grown while the run goes on: tracking poses as estimated, boxes as screened, frames as
+  // tracked.
   static constexpr const char* kPartialTrajectory = "CameraTrajectory.partial.txt";
   static constexpr const char* kPartialBoxes = "boxes_screened.partial.txt";
+  static constexpr const char* kPartialFrames = "frames.partial.txt";
 
   static std::vector<std::string> all();
 };
