@@ -285,11 +285,19 @@ std::string YoloDetector::description() const {
 Boxes mergeOverlapping(Boxes boxes, float iou_threshold) {
   std::stable_sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) { return a.score > b.score; });
   Boxes kept;
+  // Each kept box's own rectangle before it grew: overlap is tested against it, so a box grown
+  // by one merge cannot swallow the person standing beside (chained merges in a crowd made one
+  // box of three people, and depth screening keeps one person per box).
+  std::vector<cv::Rect2f> seeds;
   for (const Box& b : boxes) {
-    auto hit = std::find_if(kept.begin(), kept.end(),
-                            [&](const Box& k) { return iou(k.rect, b.rect) > iou_threshold; });
-    if (hit == kept.end()) kept.push_back(b);
-    else hit->rect |= b.rect;
+    auto hit = std::find_if(seeds.begin(), seeds.end(),
+                            [&](const cv::Rect2f& s) { return iou(s, b.rect) > iou_threshold; });
+    if (hit == seeds.end()) {
+      kept.push_back(b);
+      seeds.push_back(b.rect);
+    } else {
+      kept[static_cast<size_t>(hit - seeds.begin())].rect |= b.rect;
+    }
   }
   return kept;
 }

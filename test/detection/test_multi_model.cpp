@@ -48,6 +48,19 @@ TEST(MergeOverlapping, OnePersonTwoBoxesBecomeTheEnclosingBox) {
   EXPECT_TRUE(mergeOverlapping({}, 0.45f).empty());
 }
 
+// Crowd seed 1, frame 7: the extra model's box of two people side by side grows the main
+// model's box of the right one; the main model's box of the left one overlaps the grown box by
+// IoU 0.5 but the right one's own box by 0.25: two people, two boxes.
+TEST(MergeOverlapping, AGrownBoxDoesNotSwallowTheNeighbour) {
+  const Boxes in = {box(420, 26, 640, 480, 0.99f, "person"),   // the right person
+                    box(341, 50, 640, 471, 0.85f, "body"),     // both of them, the other model
+                    box(330, 38, 499, 479, 0.31f, "person")};  // the left person
+  const Boxes out = mergeOverlapping(in, 0.45f);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].rect, cv::Rect2f(341, 26, 299, 454));
+  EXPECT_EQ(out[1].rect, in[2].rect);
+}
+
 TEST(MultiModelDetector, DefaultPairCoversMoreOfTheRealPeople) {
   const cv::Mat img = cv::imread(joinPath(sharedDir(), kTumFrame));
   const cv::Mat mask = cv::imread(joinPath(sharedDir(), kTumMask), cv::IMREAD_GRAYSCALE);

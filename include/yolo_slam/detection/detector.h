@@ -94,10 +94,10 @@ class YoloDetector : public Detector {
   std::unique_ptr<Impl> impl_;
 };
 
-// Boxes sorted by decreasing score; a box overlapping an earlier (higher-scored) one by more
-// than `iou` is merged into it: the kept box grows to enclose both and keeps its label and
-// score. Two models boxing one person rarely agree on the limbs, so the enclosing box covers
-// more of them.
+// Boxes sorted by decreasing score; a box overlapping an earlier (higher-scored) kept box's own
+// rectangle by more than `iou` is merged into it: the kept box grows to enclose both and keeps
+// its label and score. Two models boxing one person rarely agree on the limbs, so the
+// enclosing box covers more of them. Overlap is never tested against a grown box.
 Boxes mergeOverlapping(Boxes boxes, float iou);
 
 // Several models on every frame, their boxes merged by mergeOverlapping(nms_threshold). Same
