@@ -117,7 +117,7 @@ const char* kUsage =
     "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
     "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). OUT/frames.txt has a\n"
     "line per frame: state, inliers, keypoints, dynamic ones, boxes, whether the detector saw\n"
-    "it, keyframe, and the frame's screening counts against its mask. On a synthetic sequence\n"
+    "it, keyframe, the screening counts against its mask, latency. On a synthetic sequence\n"
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
     "keypoints on the masks of people (person_recall) and of every moving object\n"
     "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
@@ -640,12 +640,20 @@ std::optional<screening::ScreeningMetrics> evaluateFrame(const slam::System& sys
 
 const char* kFramesHeader =
     "# rgb_stamp index state inliers keypoints dynamic boxes detected keyframe person_keypoints "
-    "person_dropped static_keypoints static_dropped\n";
+    "person_dropped static_keypoints static_dropped latency_ms\n";
+
+// Milliseconds from the frame's arrival (the camera's instant with --camera-rate or --realtime,
+// else when it was read) to now.
+double msSinceArrival(const Prepared& p) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p.arrival).count();
+}
 
 // One line of frames.txt: how tracking and screening went in this frame, to find where a run
-// went wrong (the four screening counts are -1 without a ground-truth mask).
+// went wrong (the four screening counts are -1 without a ground-truth mask; latency_ms from the
+// frame's arrival to its pose, -1 without one).
 std::string frameLine(const Prepared& p, const char* state, const slam::TrackResult* r,
-                      const slam::System* system, const std::optional<screening::ScreeningMetrics>& m) {
+                      const slam::System* system, const std::optional<screening::ScreeningMetrics>& m,
+                      double latency_ms) {
   long keypoints = 0, dynamic = 0, boxes = 0;
   if (system) {
     const features::FeatureFrame& f = system->lastFrame();
@@ -654,10 +662,10 @@ std::string frameLine(const Prepared& p, const char* state, const slam::TrackRes
     boxes = static_cast<long>(system->lastBoxes().size());
   }
   char line[256];
-  std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %d %d %d %d %d %d\n", p.stamp, p.index, state,
+  std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %d %d %d %d %d %d %.1f\n", p.stamp, p.index, state,
                 r ? r->inliers : 0, keypoints, dynamic, boxes, p.detector_ran && system ? 1 : 0,
                 r && r->keyframe_inserted ? 1 : 0, m ? m->person_total : -1, m ? m->person_dropped : -1,
-                m ? m->static_total : -1, m ? m->static_dropped : -1);
+                m ? m->static_total : -1, m ? m->static_dropped : -1, latency_ms);
   return line;
 }
 
@@ -713,11 +721,12 @@ void trackFrame(slam::System& system, Prepared& p, PartialOutputs& outputs, Loop
   if (!p.has_image) {
     ++res.skipped;
     ++res.untracked.no_image;
-    outputs.frames->append(frameLine(p, "no_image", nullptr, nullptr, std::nullopt));
+    outputs.frames->append(frameLine(p, "no_image", nullptr, nullptr, std::nullopt, -1));
     return;
   }
   const slam::TrackResult r = p.extracted ? system.trackExtracted(std::move(*p.extracted), p.boxes, p.detector_ran)
                                            : system.trackRgbd(p.bgr, p.depth, p.stamp, p.boxes, p.detector_ran);
+  const double latency_ms = msSinceArrival(p);
   if (r.state == slam::TrackingState::Ok) {
     outputs.trajectory->append(io::formatTumPose(StampedPose{p.stamp, r.T_wc}));
   } else {
@@ -727,7 +736,7 @@ void trackFrame(slam::System& system, Prepared& p, PartialOutputs& outputs, Loop
   ++res.processed;
   if (outputs.boxes) outputs.boxes->append(screenedBoxLines(p.stamp, system.lastBoxes()));
   const std::optional<screening::ScreeningMetrics> m = evaluateFrame(system, p, res.metrics);
-  outputs.frames->append(frameLine(p, slam::toString(r.state), &r, &system, m));
+  outputs.frames->append(frameLine(p, slam::toString(r.state), &r, &system, m, latency_ms));
 }
 
 template <class Source>
@@ -742,8 +751,7 @@ void runFrameLoop(Source& source, const RunSetup& setup, slam::System& system, P
     attachAsyncBoxes(setup, feed, *p, system, res);
     trackFrame(system, *p, outputs, res);
     res.frame_ms.push_back(fsw.ms());
-    res.latency_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p->arrival).count());
+    res.latency_ms.push_back(msSinceArrival(*p));
     char extra[96];
     std::snprintf(extra, sizeof extra, "%s, lost %zu", slam::toString(system.state()), res.lost_reports);
     bar.update(p->index + 1, extra);

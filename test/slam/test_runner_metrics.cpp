@@ -186,6 +186,9 @@ TEST_F(RunnerMetrics, FramesFileHasALinePerFrame) {
     long v[10];
     ASSERT_TRUE(is >> stamp >> index >> state) << line;
     for (long& x : v) ASSERT_TRUE(is >> x) << line;
+    double latency_ms = -1;
+    ASSERT_TRUE(is >> latency_ms) << line;
+    EXPECT_GT(latency_ms, 0.0) << line;
     EXPECT_EQ(index, n) << line;
     EXPECT_TRUE(state == "ok" || state == "lost" || state == "not_initialized") << line;
     ok += state == "ok" ? 1 : 0;
