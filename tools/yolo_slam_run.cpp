@@ -116,8 +116,8 @@ const char* kUsage =
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
     "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
     "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). OUT/frames.txt has a\n"
-    "line per frame: state, inliers, keypoints, dynamic ones, boxes, whether the detector saw\n"
-    "it, keyframe, the screening counts against its mask, latency. On a synthetic sequence\n"
+    "line per frame: state, inliers, keypoints, dynamic ones, boxes, whether they were detected in\n"
+    "that image, keyframe, the screening counts against its mask, latency. On a synthetic sequence\n"
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
     "keypoints on the masks of people (person_recall) and of every moving object\n"
     "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
@@ -342,6 +342,7 @@ struct Prepared {
   std::string mask_path;
   std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
   bool detector_ran = true;  // false: async detection had no new result for this frame
+  bool detected = false;     // boxes of this very image were screened (detector or box file)
   std::optional<slam::ExtractedFrame> extracted;  // extracted ahead (the extraction stage, not --sequential)
 };
 
@@ -437,6 +438,7 @@ RunSetup setUp(const Args& args) {
 
 void detectInto(const RunSetup& r, Prepared& p) {
   if (!r.stages.detection || r.async) return;
+  p.detected = true;
   if (!r.detector) {
     auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
     if (it != r.file_boxes.end()) p.boxes = it->second;
@@ -663,7 +665,7 @@ std::string frameLine(const Prepared& p, const char* state, const slam::TrackRes
   }
   char line[256];
   std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %d %d %d %d %d %d %.1f\n", p.stamp, p.index, state,
-                r ? r->inliers : 0, keypoints, dynamic, boxes, p.detector_ran && system ? 1 : 0,
+                r ? r->inliers : 0, keypoints, dynamic, boxes, p.detected ? 1 : 0,
                 r && r->keyframe_inserted ? 1 : 0, m ? m->person_total : -1, m ? m->person_dropped : -1,
                 m ? m->static_total : -1, m ? m->static_dropped : -1, latency_ms);
   return line;
@@ -682,6 +684,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
   res.boxes_expired += feed.expired() - expired_before;
   p.detector_ran = fb.fresh;
   if (!fb.fresh) return;
+  p.detected = true;
   ++res.boxes_fresh;
   p.boxes = fb.boxes;
   system.recordDetectionTime(newest->ms);

@@ -194,6 +194,7 @@ TEST_F(RunnerMetrics, FramesFileHasALinePerFrame) {
     ok += state == "ok" ? 1 : 0;
     EXPECT_GE(v[1], v[2]) << "dynamic keypoints are keypoints: " << line;
     EXPECT_GE(v[6], 0) << "the synthetic sequence has masks: " << line;
+    EXPECT_EQ(v[4], 1) << "every frame's own boxes (--boxes-from-gt): " << line;
     persons += v[6];
     persons_dropped += v[7];
     ++n;
