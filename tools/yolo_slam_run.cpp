@@ -116,8 +116,9 @@ const char* kUsage =
     "OUT/stats.json (counts, ATE if DIR/groundtruth.txt exists, timings, keypoints in boxes /\n"
     "kept / dropped) and, in modes detect and detect+geometry, OUT/boxes_screened.txt (every box\n"
     "screened, per frame: stamp index label x1 y1 x2 y2 score tracked). OUT/frames.txt has a\n"
-    "line per frame: state, inliers, keypoints, dynamic ones, boxes, whether they were detected in\n"
-    "that image, keyframe, the screening counts against its mask, latency. On a synthetic sequence\n"
+    "line per frame: state, inliers, keypoints, dynamic ones, boxes, how many frames older the\n"
+    "image of its new detection is (0: its own; -1: none new), keyframe, the screening counts\n"
+    "against its mask, latency. On a synthetic sequence\n"
     "(DIR/masks/, from yolo_slam_synth) stats.json also gets screening_metrics: recall of the\n"
     "keypoints on the masks of people (person_recall) and of every moving object\n"
     "(dynamic_recall), and retention of the static keypoints inside the boxes.\n"
@@ -342,7 +343,7 @@ struct Prepared {
   std::string mask_path;
   std::chrono::steady_clock::time_point arrival;  // --camera-rate: when the camera gave it
   bool detector_ran = true;  // false: async detection had no new result for this frame
-  bool detected = false;     // boxes of this very image were screened (detector or box file)
+  long detected_image = -1;  // index of the image whose new detection this frame screened (-1: none)
   std::optional<slam::ExtractedFrame> extracted;  // extracted ahead (the extraction stage, not --sequential)
 };
 
@@ -438,7 +439,7 @@ RunSetup setUp(const Args& args) {
 
 void detectInto(const RunSetup& r, Prepared& p) {
   if (!r.stages.detection || r.async) return;
-  p.detected = true;
+  p.detected_image = static_cast<long>(p.index);
   if (!r.detector) {
     auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
     if (it != r.file_boxes.end()) p.boxes = it->second;
@@ -641,7 +642,7 @@ std::optional<screening::ScreeningMetrics> evaluateFrame(const slam::System& sys
 }
 
 const char* kFramesHeader =
-    "# rgb_stamp index state inliers keypoints dynamic boxes detected keyframe person_keypoints "
+    "# rgb_stamp index state inliers keypoints dynamic boxes box_age keyframe person_keypoints "
     "person_dropped static_keypoints static_dropped latency_ms\n";
 
 // Milliseconds from the frame's arrival (the camera's instant with --camera-rate or --realtime,
@@ -663,9 +664,11 @@ std::string frameLine(const Prepared& p, const char* state, const slam::TrackRes
     dynamic = static_cast<long>(std::count_if(f.dynamic.begin(), f.dynamic.end(), [](auto d) { return d != 0; }));
     boxes = static_cast<long>(system->lastBoxes().size());
   }
+  // Frames between the detected image and this one: 0 its own boxes, -1 no new detection.
+  const long box_age = p.detected_image >= 0 ? static_cast<long>(p.index) - p.detected_image : -1;
   char line[256];
-  std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %d %d %d %d %d %d %.1f\n", p.stamp, p.index, state,
-                r ? r->inliers : 0, keypoints, dynamic, boxes, p.detected ? 1 : 0,
+  std::snprintf(line, sizeof line, "%.6f %zu %s %d %ld %ld %ld %ld %d %d %d %d %d %.1f\n", p.stamp, p.index, state,
+                r ? r->inliers : 0, keypoints, dynamic, boxes, box_age,
                 r && r->keyframe_inserted ? 1 : 0, m ? m->person_total : -1, m ? m->person_dropped : -1,
                 m ? m->static_total : -1, m ? m->static_dropped : -1, latency_ms);
   return line;
@@ -684,7 +687,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
   res.boxes_expired += feed.expired() - expired_before;
   p.detector_ran = fb.fresh;
   if (!fb.fresh) return;
-  p.detected = true;
+  p.detected_image = fb.source_frame;
   ++res.boxes_fresh;
   p.boxes = fb.boxes;
   system.recordDetectionTime(newest->ms);

@@ -194,7 +194,7 @@ TEST_F(RunnerMetrics, FramesFileHasALinePerFrame) {
     ok += state == "ok" ? 1 : 0;
     EXPECT_GE(v[1], v[2]) << "dynamic keypoints are keypoints: " << line;
     EXPECT_GE(v[6], 0) << "the synthetic sequence has masks: " << line;
-    EXPECT_EQ(v[4], 1) << "every frame's own boxes (--boxes-from-gt): " << line;
+    EXPECT_EQ(v[4], 0) << "every frame's own boxes (--boxes-from-gt): " << line;
     persons += v[6];
     persons_dropped += v[7];
     ++n;
@@ -416,6 +416,22 @@ TEST_F(RunnerMetrics, AsyncMaxLagBoundsHowOldAFramesBoxesAre) {
   EXPECT_EQ(numberOf(det, "detected"), 12) << det.dump();
   EXPECT_GE(numberOf(det, "frames_with_new_boxes"), 11) << det.dump();
   EXPECT_EQ(numberOf(js, "awaiting_detection"), 0) << js.dump();
+  // frames.txt's box_age: how many frames older the detected image is, never more than the lag.
+  std::istringstream in(readAll(joinPath(out, "frames.txt")));
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_NE(line.find(" box_age "), std::string::npos) << line;
+  long with_new_boxes = 0;
+  while (std::getline(in, line)) {
+    std::istringstream is(line);
+    std::string stamp, index, state;
+    long inliers, keypoints, dynamic, boxes, box_age;
+    ASSERT_TRUE(is >> stamp >> index >> state >> inliers >> keypoints >> dynamic >> boxes >> box_age) << line;
+    EXPECT_GE(box_age, -1) << line;
+    EXPECT_LE(box_age, 1) << line;
+    with_new_boxes += box_age >= 0 ? 1 : 0;
+  }
+  EXPECT_EQ(with_new_boxes, numberOf(det, "frames_with_new_boxes")) << det.dump();
 }
 
 TEST_F(RunnerMetrics, SavedMapIsLoadedForLocalization) {
