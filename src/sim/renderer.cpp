@@ -63,26 +63,17 @@ bool setupQuad(const CameraModel& cam, const Pose& T_cw, const Quad& q, int bx0,
   return s.x0 <= s.x1 && s.y0 <= s.y1;
 }
 
-inline void bilinear3(const cv::Mat& img, float x, float y, float out[3]) {
+// Bilinear sample of an 8-bit image with C interleaved channels, clamped to the image.
+template <int C>
+inline void bilinear(const cv::Mat& img, float x, float y, float out[C]) {
   x = std::min(std::max(x, 0.f), img.cols - 1.001f);
   y = std::min(std::max(y, 0.f), img.rows - 1.001f);
   int ix = (int)x, iy = (int)y;
   float fx = x - ix, fy = y - iy;
-  const uchar* p0 = img.ptr<uchar>(iy) + 3 * ix;
+  const uchar* p0 = img.ptr<uchar>(iy) + C * ix;
   const uchar* p1 = p0 + img.step[0];
-  for (int k = 0; k < 3; ++k)
-    out[k] = (1 - fy) * ((1 - fx) * p0[k] + fx * p0[k + 3]) + fy * ((1 - fx) * p1[k] + fx * p1[k + 3]);
-}
-
-inline void bilinear4(const cv::Mat& img, float x, float y, float out[4]) {
-  x = std::min(std::max(x, 0.f), img.cols - 1.001f);
-  y = std::min(std::max(y, 0.f), img.rows - 1.001f);
-  int ix = (int)x, iy = (int)y;
-  float fx = x - ix, fy = y - iy;
-  const uchar* p0 = img.ptr<uchar>(iy) + 4 * ix;
-  const uchar* p1 = p0 + img.step[0];
-  for (int k = 0; k < 4; ++k)
-    out[k] = (1 - fy) * ((1 - fx) * p0[k] + fx * p0[k + 4]) + fy * ((1 - fx) * p1[k] + fx * p1[k + 4]);
+  for (int k = 0; k < C; ++k)
+    out[k] = (1 - fy) * ((1 - fx) * p0[k] + fx * p0[k + C]) + fy * ((1 - fx) * p1[k] + fx * p1[k + C]);
 }
 
 inline uchar sat(float v) { return (uchar)std::min(255.f, std::max(0.f, v + 0.5f)); }
@@ -100,7 +91,7 @@ inline void mipSample(const Texture& tex, double tpm, double z_ifx, double cosan
   int L = 0;
   if (fp > 1.0) L = std::min((int)tex.levels.size() - 1, std::ilogb(fp));
   const float sc = 1.f / (float)(1 << L);
-  bilinear3(tex.levels[L], tx * sc - 0.5f, ty * sc - 0.5f, col);
+  bilinear<3>(tex.levels[L], tx * sc - 0.5f, ty * sc - 0.5f, col);
 }
 
 // Everything drawQuad needs besides the quad.
@@ -142,7 +133,7 @@ void drawQuad(const DrawContext& c, const Quad& q, const Setup& s) {
       float col[4];
       if (q.sprite) {
         const cv::Mat& img = q.sprite->bgra;
-        bilinear4(img, tx - 0.5f, ty - 0.5f, col);
+        bilinear<4>(img, tx - 0.5f, ty - 0.5f, col);
         if (col[3] < 128.f) continue;
         int rx = std::min(std::max((int)tx, 0), img.cols - 1);
         int ry = std::min(std::max((int)ty, 0), img.rows - 1);
