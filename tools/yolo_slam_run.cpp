@@ -438,7 +438,7 @@ RunSetup setUp(const Args& args) {
 }
 
 void detectInto(const RunSetup& r, Prepared& p) {
-  if (!r.stages.detection || r.async) return;
+  if (!r.stages.detection || r.async || !p.has_image) return;
   p.detected_image = static_cast<long>(p.index);
   if (!r.detector) {
     auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
