@@ -63,15 +63,15 @@ void BoxTrackerOptions::validate(const std::string& where) const {
 BoxTracker::BoxTracker(const BoxTrackerOptions& options) : opt_(options) { opt_.validate(); }
 
 bool BoxTracker::displacement(const Track& t, const features::FeatureFrame& frame,
-                              cv::Point2f& d) const {
+                              const features::KeypointIndex& index, cv::Point2f& d) const {
   if (t.pts.empty()) return false;
   std::vector<float> dx, dy;
   dx.reserve(t.pts.size());
   dy.reserve(t.pts.size());
   for (size_t k = 0; k < t.pts.size(); ++k) {
     const cv::Point2f p = t.pts[k];
-    const int best_i = features::bestMatchNear(frame, p, t.desc.ptr<uint8_t>(static_cast<int>(k)),
-                                               opt_.radius_px, opt_.max_hamming);
+    const int best_i =
+        index.bestMatchNear(p, t.desc.ptr<uint8_t>(static_cast<int>(k)), opt_.radius_px, opt_.max_hamming);
     if (best_i < 0) continue;
     dx.push_back(frame.keypoints[best_i].pt.x - p.x);
     dy.push_back(frame.keypoints[best_i].pt.y - p.y);
@@ -177,11 +177,13 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
   // How far each track's keypoints moved since the last frame: carries undetected tracks, and
   // (shift_stale, on a stream with detections of earlier images) measures the person's travel
   // that such a detection missed.
+  std::optional<features::KeypointIndex> index;  // built for the first track that needs it
   for (size_t t = 0; t < tracks_.size(); ++t) {
     Track& tr = tracks_[t];
     cv::Point2f d;
     const bool needed = track_det[t] < 0 || (opt_.shift_stale && stream_has_stale_);
-    tr.moved_now = needed && displacement(tr, frame, d) ? std::optional<cv::Point2f>(d) : std::nullopt;
+    if (needed && !index) index.emplace(frame, opt_.radius_px);
+    tr.moved_now = needed && displacement(tr, frame, *index, d) ? std::optional<cv::Point2f>(d) : std::nullopt;
   }
   detection::Boxes out = detections;
   for (size_t t = 0; t < tracks_.size(); ++t)

@@ -16,6 +16,7 @@
 //             tracker.observe(frame);                        // after screening
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/features/feature_frame.h"
+#include "yolo_slam/features/match_near.h"
 
 #include <opencv2/core.hpp>
 
@@ -114,9 +115,10 @@ class BoxTracker {
     cv::Point2f travel{0.f, 0.f};    // sum of the keypoint displacements since the track began
     std::deque<Seen> seen;           // travel in the last kSeenFrames frames, oldest first
   };
-  // Median displacement of t's remembered keypoints matched into frame; false when fewer than
-  // min_matches match.
-  bool displacement(const Track& t, const features::FeatureFrame& frame, cv::Point2f& d) const;
+  // Median displacement of t's remembered keypoints matched into the frame `index` holds; false
+  // when fewer than min_matches match.
+  bool displacement(const Track& t, const features::FeatureFrame& frame, const features::KeypointIndex& index,
+                    cv::Point2f& d) const;
   // For each track, the detection associated to it (-1: none).
   std::vector<int> associate(const detection::Boxes& detections) const;
   // t's travel at `stamp` (a frame it saw, or between two), if it remembers that far back
