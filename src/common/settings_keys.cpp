@@ -202,6 +202,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.youngMapFrames",
       "Tracking.youngPointCheck",
       "Tracking.boxedPointsStaticOnly",
+      "Tracking.droppedMapMatches",
   };
   return keys;
 }

@@ -138,10 +138,46 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
   return n;
 }
 
+namespace {
+
+// The best dynamic keypoints near a projection: one the frame-to-frame test saw move (or any,
+// when it did not run), and one it did not (for DroppedMatching), each at the point's depth.
+struct DynamicCandidates {
+  int moved = kNoMatch;
+  int unmoved = kNoMatch, unmoved2 = kNoMatch, unmoved_idx = -1;
+};
+
+DynamicCandidates dynamicCandidates(const Frame& F, const Projection& p, double r) {
+  DynamicCandidates c;
+  for (size_t j : F.featuresInArea(p.u, p.v, r, p.level - 1, p.level, true)) {
+    if (p.z > 0 && F.depth[j] > 0 && std::fabs(F.depth[j] - p.z) > kDynamicDepthTolerance * p.z) continue;
+    const int d = dist(p.mp->descriptor, F.descriptors, static_cast<int>(j));
+    // When the frame-to-frame test ran, only a keypoint it saw move counts as a hit: static
+    // background that screening dropped inside a person's box matches its own map point
+    // perfectly, and marking it erased the map behind every passing person (ATE on the
+    // walking presets 6.8-20.9 mm with that, 3.9-11 mm without; docs/ablation.md).
+    if (F.motion.empty() || F.motion[j] == 0) {
+      c.moved = std::min(c.moved, d);
+    } else if (!F.points[j]) {
+      if (d < c.unmoved) {
+        c.unmoved2 = c.unmoved;
+        c.unmoved = d;
+        c.unmoved_idx = static_cast<int>(j);
+      } else if (d < c.unmoved2) {
+        c.unmoved2 = d;
+      }
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
 int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, double nn_ratio,
-                      std::vector<MapPointPtr>* dynamic_hits) {
+                      std::vector<MapPointPtr>* dynamic_hits, const DroppedMatching* dropped) {
   int n = 0;
   const auto& pyr = *F.pyramid;
+  const bool match_dropped = dropped && dropped->min_observations > 0 && !F.motion.empty();
   for (const Projection& p : proj) {
     const MapPointPtr& mp = p.mp;
     if (!mp || mp->bad || mp->descriptor.empty()) continue;
@@ -154,8 +190,8 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
       if (F.right_u[j] > 0 && std::fabs(p.ur - F.right_u[j]) > r) continue;
       int d = dist(mp->descriptor, F.descriptors, static_cast<int>(j));
       if (d < best) {
-        best2 = best;
         best_level2 = best_level;
+        best2 = best;
         best = d;
         best_level = F.kps[j].octave;
         best_idx = static_cast<int>(j);
@@ -164,29 +200,26 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
         best2 = d;
       }
     }
-    if (dynamic_hits) {
-      // A point that now projects onto a dynamic keypoint with a better descriptor match than
-      // any static one sits on a moving object, if that keypoint is at the point's depth (a
-      // nearer one is a person walking in front of the point: hidden, not moving).
-      const double z = p.z;
-      int best_dyn = kNoMatch;
-      for (size_t j : F.featuresInArea(p.u, p.v, r, p.level - 1, p.level, true)) {
-        if (z > 0 && F.depth[j] > 0 && std::fabs(F.depth[j] - z) > kDynamicDepthTolerance * z) continue;
-        // When the frame-to-frame test ran, only a keypoint it saw move counts: static
-        // background that screening dropped inside a person's box matches its own map point
-        // perfectly, and marking it erased the map behind every passing person (ATE on the
-        // walking presets 6.8-20.9 mm with that, 3.9-11 mm without; docs/ablation.md).
-        if (!F.motion.empty() && F.motion[j] != 0) continue;
-        best_dyn = std::min(best_dyn, dist(mp->descriptor, F.descriptors, static_cast<int>(j)));
-      }
-      if (best_dyn <= kThLow && best_dyn < best) {
-        dynamic_hits->push_back(mp);
-        continue;
-      }
+    DynamicCandidates dyn;
+    if (dynamic_hits || match_dropped) dyn = dynamicCandidates(F, p, r);
+    // A point that now projects onto a moving keypoint with a better descriptor match than any
+    // static one sits on a moving object, if that keypoint is at the point's depth (a nearer
+    // one is a person walking in front of the point: hidden, not moving).
+    if (dynamic_hits && dyn.moved <= kThLow && dyn.moved < best) {
+      dynamic_hits->push_back(mp);
+      continue;
     }
     if (best <= kThHigh && best_idx >= 0) {
       if (best_level == best_level2 && best > nn_ratio * best2) continue;
       F.points[best_idx] = mp;
+      ++n;
+      continue;
+    }
+    if (match_dropped && dyn.unmoved <= kThLow && dyn.unmoved < nn_ratio * std::min(dyn.unmoved2, best) &&
+        mp->numObservations() >= dropped->min_observations) {
+      F.points[dyn.unmoved_idx] = mp;
+      F.dynamic[dyn.unmoved_idx] = 0;
+      if (dropped->matched) dropped->matched->push_back(dyn.unmoved_idx);
       ++n;
     }
   }

@@ -273,6 +273,7 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
     lock_wait_ms = sw.ms();
     res = tracker_->track(frame);
     reset_requested = tracker_->resetRequested();
+    if (res.state == TrackingState::Ok) markStaticAgain(frame.stamp, tracker_->lastDroppedMatched());
   }
   const double ms = sw.ms();
   if (res.state == TrackingState::Ok && !res.T_wc.matrix().allFinite()) res.state = TrackingState::Lost;
@@ -293,6 +294,15 @@ TrackResult System::trackFeatures(const features::FeatureFrame& frame) {
     mapper_->waitIdle();
   }
   return res;
+}
+
+void System::markStaticAgain(double stamp, const std::vector<int>& keypoints) {
+  if (keypoints.empty()) return;
+  std::lock_guard<std::mutex> lk(last_frame_mutex_);
+  if (last_frame_.stamp != stamp) return;
+  for (int i : keypoints) {
+    if (i >= 0 && static_cast<size_t>(i) < last_frame_.dynamic.size()) last_frame_.dynamic[i] = 0;
+  }
 }
 
 void System::runBackEndInline() {
@@ -484,7 +494,8 @@ SystemStats System::stats() const {
   }
   LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
-  size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0, vo_frames = 0;
+  size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0, dropped_matched = 0,
+         vo_frames = 0;
   {
     std::lock_guard<std::mutex> tl(track_mutex_);
     relocs = tracker_->relocalizations();
@@ -492,6 +503,7 @@ SystemStats System::stats() const {
     from_prediction = tracker_->trackedFromPrediction();
     young_dropped = tracker_->youngPointsDropped();
     boxed_withheld = tracker_->boxedPointsWithheld();
+    dropped_matched = tracker_->droppedMatched();
     vo_frames = tracker_->voFrames();
   }
   const size_t loops = loop_closer_ ? loop_closer_->loopsClosed() : 0;
@@ -512,6 +524,7 @@ SystemStats System::stats() const {
   s.tracked_from_prediction = from_prediction;
   s.young_points_dropped = young_dropped;
   s.boxed_points_withheld = boxed_withheld;
+  s.dropped_map_matches = dropped_matched;
   s.vo_frames = vo_frames;
   s.loops_closed = loops;
   s.global_bas = gbas;
@@ -550,6 +563,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"tracked_from_prediction", s.tracked_from_prediction},
               {"young_points_dropped", s.young_points_dropped},
               {"boxed_points_withheld", s.boxed_points_withheld},
+              {"dropped_map_matches", s.dropped_map_matches},
               {"vo_frames", s.vo_frames},
               {"loops_closed", s.loops_closed},
               {"global_bundle_adjustments", s.global_bas},

@@ -122,6 +122,7 @@ Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map,
 TrackResult Tracking::track(const features::FeatureFrame& ff) {
   reset_requested_ = false;
   ++frames_;
+  dropped_matched_.clear();
   Frame F(ff, cam_, geom_, pyr_, next_frame_id_++);
   checkTimestamp(F);
   if (state_ == TrackingState::NotInitialized) return trackFirst(F);
@@ -644,7 +645,24 @@ void Tracking::searchLocalPoints(Frame& F) {
   }
   if (proj.empty()) return;
   dynamic_hits_.clear();
-  matcher::searchProjections(F, proj, opt_.local_window, kLocalRatio, &dynamic_hits_);
+  dropped_matched_.clear();
+  matcher::DroppedMatching dropped;
+  // Only in a map this run does not change: in SLAM mode the matches measured no better.
+  dropped.min_observations = localization_only_ ? opt_.dropped_map_matches : 0;
+  dropped.matched = &dropped_matched_;
+  matcher::searchProjections(F, proj, opt_.local_window, kLocalRatio, &dynamic_hits_, &dropped);
+}
+
+void Tracking::settleDroppedMatches(Frame& F) {
+  size_t kept = 0;
+  for (int j : dropped_matched_) {
+    if (F.points[j]) {
+      dropped_matched_[kept++] = j;
+    } else {
+      F.dynamic[j] = 1;
+    }
+  }
+  dropped_matched_.resize(kept);
 }
 
 bool Tracking::trackLocalMap(Frame& F) {
@@ -664,7 +682,10 @@ bool Tracking::trackLocalMap(Frame& F) {
       F.points[i].reset();
     }
   }
-  return inliers_ >= minInliers(F);
+  settleDroppedMatches(F);
+  const bool ok = inliers_ >= minInliers(F);
+  if (ok) dropped_matched_total_ += dropped_matched_.size();
+  return ok;
 }
 
 int Tracking::minInliers(const Frame& F) const {

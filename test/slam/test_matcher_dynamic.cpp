@@ -1,7 +1,11 @@
 // Local-map search and dynamic keypoints (matcher::searchProjections): a map point whose best
 // match is a dynamic keypoint at its own depth lies on a moving object and is reported; one
 // hidden behind a nearer dynamic keypoint (a person walking in front of the wall) is not, nor
-// one matching a dropped keypoint that the frame-to-frame test found static.
+// one matching a dropped keypoint that the frame-to-frame test found static. With
+// DroppedMatching (Tracking.droppedMapMatches) such a point seen by enough keyframes matches
+// that keypoint, which becomes static.
+#include "yolo_slam/slam/keyframe.h"
+#include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/frame.h"
 #include "yolo_slam/slam/map_point.h"
 #include "yolo_slam/slam/matcher.h"
@@ -62,8 +66,13 @@ struct Result {
   size_t dynamic_hits = 0;
 };
 
-Result search(Frame& F, const cv::Mat& desc) {
+Result search(Frame& F, const cv::Mat& desc, int observations = 0, const DroppedMatching* dropped = nullptr) {
   auto mp = std::make_shared<MapPoint>(1, Eigen::Vector3d(0, 0, 2), nullptr, 0);
+  std::vector<KeyFramePtr> kfs;  // keep the observing keyframes alive through the search
+  for (int k = 0; k < observations; ++k) {
+    kfs.push_back(std::make_shared<KeyFrame>(k + 1, F));
+    Map::addObservation(mp, kfs.back(), 0);
+  }
   mp->descriptor = desc.clone();
   Projection p;
   p.mp = mp;
@@ -74,7 +83,7 @@ Result search(Frame& F, const cv::Mat& desc) {
   p.level = 0;
   std::vector<MapPointPtr> hits;
   Result r;
-  r.matched = searchProjections(F, {p}, 1.0, 0.8, &hits);
+  r.matched = searchProjections(F, {p}, 1.0, 0.8, &hits, dropped);
   r.dynamic_hits = hits.size();
   return r;
 }
@@ -128,4 +137,68 @@ TEST(MatcherDynamic, StaticKeypointAtTheProjectionIsMatched) {
   EXPECT_EQ(r.dynamic_hits, 0u);
   EXPECT_EQ(r.matched, 1);
   EXPECT_TRUE(F.points[0] != nullptr);
+}
+
+namespace {
+
+// The dropped keypoint at the projection, not seen moving (`motion`), at depth `z`; the point
+// seen by `observations` keyframes; DroppedMatching asking for `min_observations`.
+struct DroppedCase {
+  int motion = 1;
+  double z = pointDepth();
+  int observations = 3;
+  int min_observations = 3;
+};
+
+struct DroppedOutcome {
+  int matched = 0;
+  std::vector<int> now_static;
+  bool keypoint_dynamic = true;
+};
+
+DroppedOutcome searchDropped(const DroppedCase& c) {
+  const cv::Mat d = randomDescriptor(7);
+  Frame F = makeFrame(d, true, c.z);
+  F.motion.assign(F.N, -1);
+  F.motion[0] = static_cast<int8_t>(c.motion);
+  DroppedOutcome out;
+  DroppedMatching dropped;
+  dropped.min_observations = c.min_observations;
+  dropped.matched = &out.now_static;
+  out.matched = search(F, d, c.observations, &dropped).matched;
+  out.keypoint_dynamic = F.dynamic[0] != 0;
+  return out;
+}
+
+}  // namespace
+
+TEST(MatcherDropped, KeypointNotSeenMovingMatchesAnEstablishedPoint) {
+  for (int motion : {1, -1}) {
+    DroppedCase c;
+    c.motion = motion;
+    const DroppedOutcome o = searchDropped(c);
+    EXPECT_EQ(o.matched, 1) << "motion " << motion;
+    EXPECT_EQ(o.now_static, std::vector<int>{0});
+    EXPECT_FALSE(o.keypoint_dynamic);
+  }
+  DroppedCase no_depth;
+  no_depth.z = -1.0;  // far room beyond the sensor's range: the descriptor decides
+  EXPECT_EQ(searchDropped(no_depth).matched, 1);
+}
+
+TEST(MatcherDropped, MovedKeypointYoungPointOtherDepthOrOffStayDynamic) {
+  DroppedCase moved;
+  moved.motion = 0;
+  DroppedCase young;
+  young.observations = 2;
+  DroppedCase nearer;
+  nearer.z = pointDepth() - 0.5;  // a person in front of the point
+  DroppedCase off;
+  off.min_observations = 0;
+  for (const DroppedCase& c : {moved, young, nearer, off}) {
+    const DroppedOutcome o = searchDropped(c);
+    EXPECT_EQ(o.matched, 0);
+    EXPECT_TRUE(o.now_static.empty());
+    EXPECT_TRUE(o.keypoint_dynamic);
+  }
 }

@@ -138,6 +138,7 @@ Tracking.maxStampGap: 0.5
 Tracking.localMapFromPrediction: 0
 Tracking.youngPointCheck: 0
 Tracking.boxedPointsStaticOnly: 0
+Tracking.droppedMapMatches: 5
 LocalMapping.triangulationNeighbours: 12
 LocalMapping.fuseNeighbours: 8
 LocalMapping.cullingRedundancy: 0.875
@@ -297,6 +298,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points, k.reloc_min_inliers),
             std::make_tuple(45, 3, 150, 40));
   EXPECT_EQ(k.vo_below_map_points, 40);
+  EXPECT_EQ(k.dropped_map_matches, 5);
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   const slam::LocalMappingOptions& p = sys.slam.mapping;

@@ -47,8 +47,20 @@ int searchLastFrame(Frame& F, const Frame& last, double th);
 // their own depth (within kDynamicDepthTolerance, or without depth) that the frame-to-frame
 // test saw move (Frame::motion 0; any dynamic keypoint when the test did not run) are
 // appended to `dynamic_hits` (if given) instead of being matched.
+//
+// `dropped` (if given, and the frame-to-frame test ran): a point seen by at least
+// `min_observations` keyframes that finds no static keypoint may match a dynamic keypoint the
+// test did not see move (Frame::motion 1 or -1) at its own depth (or without depth), within
+// kThLow and the ratio test: background the screening dropped inside a person's box matches its
+// own point. The keypoint becomes static (Frame::dynamic 0) and its index is appended to
+// `matched`; the caller puts it back when the pose calls it an outlier.
+struct DroppedMatching {
+  int min_observations = 0;  // 0: off
+  std::vector<int>* matched = nullptr;
+};
 int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, double nn_ratio,
-                      std::vector<MapPointPtr>* dynamic_hits = nullptr);
+                      std::vector<MapPointPtr>* dynamic_hits = nullptr,
+                      const DroppedMatching* dropped = nullptr);
 
 // BoW search between a keyframe and a frame (ORB-SLAM2 SearchByBoW) through their
 // FeatureVectors; requires both BoW slots filled. Matches written into F.points.

@@ -81,6 +81,12 @@ struct TrackingOptions {
   // depth cluster: mostly the room, sometimes a person the detector missed behind the boxed
   // one, whose points would pull the next frames' poses. They still match existing map points.
   bool boxed_points_static_only = true;  // Tracking.boxedPointsStaticOnly
+  // Beyond ORB-SLAM2, localization mode only: in the local-map search, a map point seen by at
+  // least this many keyframes that finds no static keypoint may match a keypoint the screening
+  // dropped, if the frame-to-frame test did not see it move and it lies at the point's depth (or
+  // has none); it is static again when the pose keeps it as an inlier (matcher::DroppedMatching).
+  // The room behind a person's box matches its own points of the loaded map. 0: off.
+  int dropped_map_matches = 3;  // Tracking.droppedMapMatches
 
   static TrackingOptions load(const Config& cfg);
 };

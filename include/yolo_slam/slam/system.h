@@ -71,6 +71,7 @@ struct SystemStats {
   size_t tracked_from_prediction = 0;  // frames tracked from the prediction (Tracking.localMapFromPrediction)
   size_t young_points_dropped = 0;     // matches released by Tracking.youngPointCheck
   size_t boxed_points_withheld = 0;    // keyframe points withheld by Tracking.boxedPointsStaticOnly
+  size_t dropped_map_matches = 0;      // dropped keypoints static again by Tracking.droppedMapMatches
   size_t vo_frames = 0;                // localization mode: frames with temporary points (Tracking.voBelowMapPoints)
   // Frames not tracked because no map may start before the first detection (counted as lost).
   size_t awaiting_detection = 0;
@@ -90,7 +91,7 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 
 // The counts of stats.json, shared by System::statsJson and yolo_slam_run: frames, tracked,
 // lost, keyframes, keyframes_culled, map_points, map_resets, relocalizations, jumps_refused,
-// tracked_from_prediction, young_points_dropped, boxed_points_withheld, vo_frames, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
+// tracked_from_prediction, young_points_dropped, boxed_points_withheld, dropped_map_matches, vo_frames, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
 // {...}, boxes_screened {...},
 // feature_budget_mean (nFeatures multiples extracted, mean over the frames).
 Json statsCountsJson(const SystemStats& s);
@@ -229,6 +230,9 @@ class System {
   MapFileContext mapFileContext() const;
   // Sequential mode: local mapping, then loop closing, on what the last frame queued.
   void runBackEndInline();
+  // Tracking.droppedMapMatches: the keypoints of the frame stamped `stamp` that tracking made
+  // static again are static in lastFrame() too (what the screening metrics read).
+  void markStaticAgain(double stamp, const std::vector<int>& keypoints);
   frontend::FrontEnd& frontEnd();  // made on first use
 
   CameraModel cam_;

@@ -74,6 +74,10 @@ class Tracking {
   // Matches of once-seen map points released by Tracking.youngPointCheck.
   size_t youngPointsDropped() const { return young_dropped_; }
   size_t boxedPointsWithheld() const { return boxed_withheld_; }
+  // Dropped keypoints matched to map points and kept by the pose (Tracking.droppedMapMatches):
+  // in all, and those of the last frame (indices into its keypoints).
+  size_t droppedMatched() const { return dropped_matched_total_; }
+  const std::vector<int>& lastDroppedMatched() const { return dropped_matched_; }
   // Localization mode: frames tracked with temporary points in the last frame (Tracking.voPoints,
   // voBelowMapPoints).
   size_t voFrames() const { return vo_frames_; }
@@ -138,6 +142,9 @@ class Tracking {
   void updateLocalMap(Frame& F);
   void searchLocalPoints(Frame& F);
   int optimizePose(Frame& F);
+  // Tracking.droppedMapMatches: the dropped keypoints matched in the local-map search that the
+  // pose did not keep are dynamic again.
+  void settleDroppedMatches(Frame& F);
   // Pose-only optimisation, then the outlier matches are released; returns the matches to
   // points that are in the map (motion-model and reference-keyframe tracking).
   int optimizePoseAndDropOutliers(Frame& F);
@@ -194,6 +201,8 @@ class Tracking {
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
   size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly
+  std::vector<int> dropped_matched_;   // this frame's dropped keypoints matched to map points
+  size_t dropped_matched_total_ = 0;
   size_t vo_frames_ = 0;       // frames whose last frame got temporary points
   long init_kf_id_ = -1;      // the first keyframe of the map being built (-1: a loaded map)
 };
