@@ -190,8 +190,8 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
       if (F.right_u[j] > 0 && std::fabs(p.ur - F.right_u[j]) > r) continue;
       int d = dist(mp->descriptor, F.descriptors, static_cast<int>(j));
       if (d < best) {
-        best_level2 = best_level;
         best2 = best;
+        best_level2 = best_level;
         best = d;
         best_level = F.kps[j].octave;
         best_idx = static_cast<int>(j);

@@ -645,7 +645,6 @@ void Tracking::searchLocalPoints(Frame& F) {
   }
   if (proj.empty()) return;
   dynamic_hits_.clear();
-  dropped_matched_.clear();
   matcher::DroppedMatching dropped;
   // Only in a map this run does not change: in SLAM mode the matches measured no better.
   dropped.min_observations = localization_only_ ? opt_.dropped_map_matches : 0;
