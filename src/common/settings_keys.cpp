@@ -202,6 +202,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.youngMapFrames",
       "Tracking.youngPointCheck",
       "Tracking.boxedPointsStaticOnly",
+      "Tracking.movedPointsWithheld",
       "Tracking.droppedMapMatches",
   };
   return keys;

@@ -40,6 +40,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.localMapFromPrediction", &O::local_map_from_prediction},
       {"Tracking.youngPointCheck", &O::young_point_check},
       {"Tracking.boxedPointsStaticOnly", &O::boxed_points_static_only},
+      {"Tracking.movedPointsWithheld", &O::moved_points_withheld},
       {"Tracking.droppedMapMatches", &O::dropped_map_matches, Range::atLeast(0)},
   };
   return table;

@@ -736,7 +736,9 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
 
 bool Tracking::mayMakeKeyFramePoint(const Frame& F, int i) const {
   // A young map made while people filled the view needs every static point it can get.
-  if (!opt_.boxed_points_static_only || youngMap(F) || F.boxed.empty() || !F.boxed[i]) return true;
+  if (youngMap(F)) return true;
+  if (opt_.moved_points_withheld && !F.motion.empty() && F.motion[i] == 0) return false;
+  if (!opt_.boxed_points_static_only || F.boxed.empty() || !F.boxed[i]) return true;
   return !F.seenMoving(i);
 }
 

@@ -138,6 +138,7 @@ Tracking.maxStampGap: 0.5
 Tracking.localMapFromPrediction: 0
 Tracking.youngPointCheck: 0
 Tracking.boxedPointsStaticOnly: 0
+Tracking.movedPointsWithheld: 0
 Tracking.droppedMapMatches: 5
 LocalMapping.triangulationNeighbours: 12
 LocalMapping.fuseNeighbours: 8
@@ -295,6 +296,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.lost_reset_frames, k.lost_reset_max_keyframes, k.vo_points, k.max_stamp_gap,
                      k.local_map_from_prediction, k.young_point_check, k.boxed_points_static_only),
             std::make_tuple(120, 4, 80, 0.5, false, false, false));
+  EXPECT_FALSE(k.moved_points_withheld);
   EXPECT_EQ(std::tie(k.young_map_frames, k.young_lost_reset_frames, k.keyframe_points, k.reloc_min_inliers),
             std::make_tuple(45, 3, 150, 40));
   EXPECT_EQ(k.vo_below_map_points, 40);

@@ -81,6 +81,11 @@ struct TrackingOptions {
   // depth cluster: mostly the room, sometimes a person the detector missed behind the boxed
   // one, whose points would pull the next frames' poses. They still match existing map points.
   bool boxed_points_static_only = true;  // Tracking.boxedPointsStaticOnly
+  // Beyond ORB-SLAM2: past a map's first young_map_frames frames, a keypoint the frame-to-frame
+  // test saw move (FeatureFrame::motion 0: not where a static point would be), inside a box or
+  // not, gives a new keyframe no map point. People the screening missed are what moves; their
+  // points would pull the next frames' poses. They still match existing map points.
+  bool moved_points_withheld = true;  // Tracking.movedPointsWithheld
   // Beyond ORB-SLAM2, localization mode only: in the local-map search, a map point seen by at
   // least this many keyframes that finds no static keypoint may match a keypoint the screening
   // dropped, if the frame-to-frame test did not see it move and it lies at the point's depth (or
