@@ -70,7 +70,7 @@ struct SystemStats {
   size_t jumps_refused = 0;  // poses refused as a jump from the motion model (Tracking.maxJump)
   size_t tracked_from_prediction = 0;  // frames tracked from the prediction (Tracking.localMapFromPrediction)
   size_t young_points_dropped = 0;     // matches released by Tracking.youngPointCheck
-  size_t boxed_points_withheld = 0;    // keyframe points withheld by Tracking.boxedPointsStaticOnly
+  size_t boxed_points_withheld = 0;    // keyframe points withheld by Tracking.boxedPointsStaticOnly and movedPointsWithheld
   size_t dropped_map_matches = 0;      // dropped keypoints static again by Tracking.droppedMapMatches
   size_t vo_frames = 0;                // localization mode: frames with temporary points (Tracking.voBelowMapPoints)
   // Frames not tracked because no map may start before the first detection (counted as lost).

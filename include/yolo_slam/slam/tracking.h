@@ -200,7 +200,7 @@ class Tracking {
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
-  size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly
+  size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly / movedPointsWithheld
   std::vector<int> dropped_matched_;   // this frame's dropped keypoints matched to map points
   size_t dropped_matched_total_ = 0;
   size_t vo_frames_ = 0;       // frames whose last frame got temporary points
