@@ -139,9 +139,9 @@ int Frame::countWithDepth() const {
 }
 
 bool Frame::seenMoving(int i) const {
-  const bool tested = !motion.empty();
-  if (tested && motion[i] == 0) return true;
-  return !boxed.empty() && boxed[i] && !(tested && motion[i] == 1);
+  if (testedMoving(i)) return true;
+  const bool static_consistent = !motion.empty() && motion[i] == 1;
+  return !boxed.empty() && boxed[i] && !static_consistent;
 }
 
 std::vector<std::pair<float, int>> Frame::staticByDepth() const {

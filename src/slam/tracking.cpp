@@ -737,7 +737,7 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
 bool Tracking::mayMakeKeyFramePoint(const Frame& F, int i) const {
   // A young map made while people filled the view needs every static point it can get.
   if (youngMap(F)) return true;
-  if (opt_.moved_points_withheld && !F.motion.empty() && F.motion[i] == 0) return false;
+  if (opt_.moved_points_withheld && F.testedMoving(i)) return false;
   if (!opt_.boxed_points_static_only || F.boxed.empty() || !F.boxed[i]) return true;
   return !F.seenMoving(i);
 }

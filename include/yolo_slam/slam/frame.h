@@ -72,6 +72,8 @@ class Frame {
   // The frame-to-frame evidence saw keypoint i move: found moved, or kept static inside a person
   // box without being found static-consistent.
   bool seenMoving(int i) const;
+  // The frame-to-frame test saw keypoint i move (motion 0); false when it did not run.
+  bool testedMoving(int i) const { return !motion.empty() && motion[i] == 0; }
   // Frees the keypoints, descriptors, BoW and grid (N becomes 0), keeping pose and camera. For
   // erased keyframes: the trajectory still refers to them for its relative poses, and without
   // this each would keep its features (about 250 KB) for the rest of the run.
