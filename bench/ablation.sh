@@ -31,7 +31,8 @@
 # OUT/seq), each mode runs R times (the system is multi-threaded, runs differ), each run is
 # evaluated with yolo_slam_eval (ATE, RPE delta 1 s); bench/ablation_table.py takes the medians
 # and writes OUT/table.md. A failed run is logged and shown as failed in the table; the script
-# carries on.
+# carries on. OUT/meta.txt records the command, commit, load and the machine's speed before and
+# after (features_bench's ORB extraction median: read frame rates of two tables against it).
 set -u
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -123,6 +124,16 @@ out="$(cd "$out" && pwd)"
 
 log() { echo "[$(date +%H:%M:%S)] $*"; }
 
+# The machine's speed: this VM's single-thread speed has varied 2.3x within an hour (ORB
+# extraction of one real frame 4.1-9.7 ms), so a frame rate means something only next to it.
+gauge() {
+  if [ -x "$bin/features_bench" ]; then
+    "$bin/features_bench" 2>/dev/null | awk '/^extract/ {print "ORB extraction of the shared TUM frame, median " $3 " ms (features_bench)"; f=1} END {if (!f) print "features_bench failed"}'
+  else
+    echo "n/a ($bin/features_bench not built)"
+  fi
+}
+
 # Everything needed to reproduce the table, read back by ablation_table.py.
 {
   echo "command: bench/ablation.sh --frames $frames --runs $runs --presets \"$presets\" --modes \"$modes\" --seed $seed${pace[*]:+ ${pace[*]}}"
@@ -130,6 +141,7 @@ log() { echo "[$(date +%H:%M:%S)] $*"; }
   echo "commit: $(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)$(git -C "$repo" diff --quiet HEAD -- src include tools 2>/dev/null || echo ' (+uncommitted changes in src/include/tools)')"
   echo "bin: $bin (yolo_slam_run built $(date -u -r "$bin/yolo_slam_run" +%Y-%m-%dT%H:%M:%SZ 2>/dev/null || echo '?'))"
   echo "load_before: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
+  [ "$table_only" = 0 ] && echo "gauge_before: $(gauge)"
   echo "cpus: $(nproc 2>/dev/null)"
 } > "$out/meta.txt.new"
 # Several invocations may fill one OUT (e.g. a second one adding ":gt" modes): keep every block.
@@ -181,7 +193,7 @@ if [ "$table_only" = 0 ]; then
   done
 fi
 
-[ "$table_only" = 0 ] && echo "finished: $(date -u +%Y-%m-%dT%H:%M:%SZ), load_after: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)" >> "$out/meta.txt"
+[ "$table_only" = 0 ] && echo "finished: $(date -u +%Y-%m-%dT%H:%M:%SZ), load_after: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null), gauge_after: $(gauge)" >> "$out/meta.txt"
 "$py" "$here/ablation_table.py" "$out" > "$out/table.md.new" && mv "$out/table.md.new" "$out/table.md" \
   || { echo "error: ablation_table.py failed on $out" >&2; exit 1; }
 log "wrote $out/table.md"

@@ -8,7 +8,8 @@ SEQ_DIR is a TUM folder with groundtruth.txt (yolo_slam_synth output); the bag i
 with scripts/tum_to_bag.py (as OUT/sequence.bag, or as --bag when that file does not exist yet). Runs `roslaunch yolo_slam tum_bag.launch`
 (source build/ws/devel/setup.bash first), reads /diagnostics until playback has ended and the
 graph has drained, saves the trajectory through /yolo_slam/save_trajectory and evaluates it
-with yolo_slam_eval. Prints one JSON object (also written to OUT/ros_realtime.json).
+with yolo_slam_eval. Prints one JSON object (also written to OUT/ros_realtime.json), with the
+machine's speed measured before the run (orb_extraction_gauge_ms: features_bench's median).
 """
 import argparse
 import json
@@ -42,6 +43,20 @@ def write_latencies(path, seen, what):
             f.write("%.6f %.1f\n" % (stamp, (now - stamp) * 1000.0))
 
 
+def speed_gauge():
+    """The machine's speed before the run: this VM's single-thread speed has varied 2.3x within
+    an hour, so latencies mean something only next to it. ORB extraction of the shared TUM frame,
+    median ms (features_bench), or None when it cannot run."""
+    try:
+        out = subprocess.run([os.path.join(BIN, "features_bench")], capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    for line in out.stdout.splitlines():
+        if line.startswith("extract"):
+            return float(line.split()[2])
+    return None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("seq")
@@ -58,6 +73,7 @@ def main():
     if not os.path.exists(bag):
         subprocess.check_call([os.path.join(REPO, "scripts", "tum_to_bag.py"), a.seq, bag])
     frames = frames_in(a.seq)
+    gauge_ms = speed_gauge()
     traj = os.path.join(a.out, "CameraTrajectory.txt")
     if os.path.exists(traj):
         os.remove(traj)
@@ -133,6 +149,7 @@ def main():
         "latency_p95_ms": float(s.get("latency_p95_ms", "nan")),
         "slam": s, "screening": scr, "ate_rmse_m": ate,
         "load": open("/proc/loadavg").read().split()[:3],
+        "orb_extraction_gauge_ms": gauge_ms,
     }
     write_latencies(os.path.join(a.out, "pose_latency.txt"), poses_seen, "pose")
     if a.stage_latency:
