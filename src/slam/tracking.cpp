@@ -178,6 +178,9 @@ bool Tracking::trackFrame(Frame& F) {
       startFromPrediction(F, prediction);
       ok = from_prediction = true;
     }
+    // No velocity (the frame after a relocalisation or a lost stretch) and the reference
+    // keyframe lost: place recognition now rather than a frame later, when the state turns Lost.
+    if (!ok && !predicted) ok = relocalize(F);
   } else {
     ok = trackWhenLost(F);
   }

@@ -96,6 +96,41 @@ TEST(SlamRelocalization, FramesAfterRelocalisationNeedRelocMinInliers) {
   EXPECT_GE(r.relocalizations, 10u);
 }
 
+// The frame right after a relocalisation has no velocity: when its reference keyframe (the
+// one it relocalised on) does not track it either, it relocalises at once. The camera circles
+// an empty room (static_xyz's room on the loop path); after a loss it jumps back to frame 10
+// (relocalised there), then on to frame 190, a wall 55 degrees further round that frame 10's
+// keyframe does not see well: frame 190 is tracked, by a second relocalisation.
+TEST(SlamRelocalization, FrameAfterARelocalisationRelocalisesAtOnce) {
+  sim::SynthOptions so = test_support::staticXyz(200, 5);
+  so.trajectory = "loop";
+  sim::SequenceGenerator gen(so);
+  slam::System sys(gen.camera(), test_support::plainSequentialOptions(), shippedVocabulary());
+  double stamp = 0;
+  for (size_t i = 0; i < gen.size(); ++i) {
+    const sim::SynthFrame f = gen.frame(i);
+    stamp = f.rgb_stamp;
+    ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
+  }
+  const test_support::BlankFrame blank = test_support::blankFrame(gen.frame(0));
+  for (int k = 0; k < 3; ++k) {
+    stamp += 1.0 / 30;
+    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
+  }
+  ASSERT_EQ(sys.state(), slam::TrackingState::Lost);
+  const size_t relocs_before = sys.stats().relocalizations;
+  stamp += 1.0 / 30;
+  const sim::SynthFrame back = gen.frame(10);
+  ASSERT_EQ(sys.trackRgbd(back.bgr, back.depth, stamp, {}).state, slam::TrackingState::Ok);
+  stamp += 1.0 / 30;
+  const sim::SynthFrame on = gen.frame(190);
+  const slam::TrackResult r = sys.trackRgbd(on.bgr, on.depth, stamp, {});
+  EXPECT_EQ(r.state, slam::TrackingState::Ok);
+  EXPECT_EQ(sys.stats().relocalizations - relocs_before, 2u);
+  const Pose gt = gen.frame(0).T_wc.inverse() * on.T_wc;
+  EXPECT_LT((gt.translation() - r.T_wc.translation()).norm(), 0.03);
+}
+
 // A map reset forgets the relocalisations of the old map: Tracking.relocMinInliers out of reach
 // makes every relocalisation in a young map fail its local-map step, the young map is reset,
 // and the new map, started right after, tracks with the ordinary Tracking.minInliers.
