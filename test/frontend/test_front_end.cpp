@@ -128,8 +128,10 @@ size_t keypointsOfTheSecondFrame(double boost_max, double* budget, int box_width
   cv::Mat depth(480, 640, CV_32F, cv::Scalar(3.0f));
   depth(cv::Rect(0, 0, box_width, 480)).setTo(1.2f);
   const frontend::FrontEndResult first = fe.process(texture(7), depth, 0.0, {half}, CameraModel());
-  // The first frame is extracted again with the budget it turned out to need.
-  EXPECT_DOUBLE_EQ(first.stats.feature_budget, box_width == 320 ? boost_max : 1.0);
+  // The first frame is extracted again with the budget it turned out to need (none for a
+  // narrow box).
+  if (box_width == 320) EXPECT_DOUBLE_EQ(first.stats.feature_budget, boost_max);
+  if (box_width <= 160) EXPECT_DOUBLE_EQ(first.stats.feature_budget, 1.0);
   EXPECT_GT(first.frame.countDynamic(), first.frame.size() * box_width / 640 / 2);
   const frontend::FrontEndResult second = fe.process(texture(8), depth, 0.033, {half}, CameraModel());
   *budget = second.stats.feature_budget;
@@ -151,6 +153,18 @@ TEST(FrontEnd, ExtractsMoreWhenScreeningDroppedMuchOfTheLastFrame) {
   double small_budget = 0;
   keypointsOfTheSecondFrame(2.0, &small_budget, 80);
   EXPECT_DOUBLE_EQ(small_budget, 1.0);
+}
+
+TEST(FrontEnd, DefaultBudgetGrowsPastTwiceWhenPeopleFillTwoThirdsOfTheView) {
+  // A crowd: a box over 70 % of the view drops about 70 % of the keypoints. Twice nFeatures
+  // would leave about 0.6 nFeatures for SLAM; the default allows more.
+  double budget = 0;
+  const size_t crowded = keypointsOfTheSecondFrame(features::OrbOptions().dynamic_boost_max, &budget, 448);
+  double capped_budget = 0;
+  const size_t capped = keypointsOfTheSecondFrame(2.0, &capped_budget, 448);
+  EXPECT_DOUBLE_EQ(capped_budget, 2.0);
+  EXPECT_GT(budget, 2.5);
+  EXPECT_GT(crowded, capped * 5 / 4);
 }
 
 TEST(FrontEnd, RejectsABoostBelowOne) {

@@ -26,8 +26,9 @@ struct OrbOptions {
   // ORBextractor.dynamicBoostMax: when screening dropped more than a quarter of the last frame's
   // keypoints, the front end extracts up to this many times nFeatures so that about nFeatures
   // stay for SLAM (1: ORB-SLAM2's fixed budget). Crowds otherwise leave too few
-  // static points to initialise and track.
-  double dynamic_boost_max = 2.0;
+  // static points to initialise and track; 3 lets a frame two thirds people keep nFeatures
+  // (BENCHMARKS.md, "Session 37").
+  double dynamic_boost_max = 3.0;
   // ORBextractor.threads: 2 extracts pyramid level 0 on a second thread beside the other
   // levels (the same keypoints and descriptors as 1, in about 60 % of the time when a core is
   // free); 1 extracts on the caller's thread only.
