@@ -86,8 +86,9 @@ TEST_F(BadSettings, TooFewFeaturesAreRefusedBeforeAnyFrame) {
   EXPECT_TRUE(contains(r.err, joinPath(seq, "camera.yaml") + ": key 'ORBextractor.nFeatures' must be >= 100 (got 1)"))
       << r;
   // Above the floor but below what initialisation needs (Tracking.initMinKeyPoints 500, at most
-  // 2 x nFeatures extracted): refused as well, naming the other key.
-  const Outcome low = runSlam(seq, {"--set", "ORBextractor.nFeatures=200"});
+  // dynamicBoostMax x nFeatures extracted, and 4 x 120 is under 500 at the largest boost
+  // allowed): refused as well, naming the other key.
+  const Outcome low = runSlam(seq, {"--set", "ORBextractor.nFeatures=120"});
   EXPECT_EQ(low.exit_code, 1) << low;
   EXPECT_TRUE(contains(low.err, "Tracking.initMinKeyPoints")) << low;
 }
