@@ -154,7 +154,20 @@ std::vector<std::pair<float, int>> Frame::staticByDepth() const {
 
 void computeBow(const vocabulary::Vocabulary* voc, Frame& F) {
   if (!voc || !F.bow.empty() || F.N == 0) return;
-  voc->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
+  std::vector<int> rows;  // the static keypoints
+  rows.reserve(F.N);
+  for (int i = 0; i < F.N; ++i)
+    if (i >= static_cast<int>(F.dynamic.size()) || !F.dynamic[i]) rows.push_back(i);
+  if (static_cast<int>(rows.size()) == F.N) {
+    voc->transform(F.descriptors, F.bow.bow, F.bow.features, kBowLevelsUp);
+    return;
+  }
+  if (rows.empty()) return;
+  cv::Mat desc(static_cast<int>(rows.size()), F.descriptors.cols, F.descriptors.type());
+  for (size_t k = 0; k < rows.size(); ++k) F.descriptors.row(rows[k]).copyTo(desc.row(static_cast<int>(k)));
+  voc->transform(desc, F.bow.bow, F.bow.features, kBowLevelsUp);
+  for (auto& node : F.bow.features)
+    for (unsigned& idx : node.second) idx = static_cast<unsigned>(rows[idx]);
 }
 
 void Frame::releaseFeatures() {

@@ -97,8 +97,10 @@ class Frame {
   std::vector<std::vector<uint32_t>> grid_;  // kGridCols * kGridRows cells of keypoint indices
 };
 
-// Fills F's BoW slot from its descriptors, unless already filled, F has no keypoints or there
-// is no vocabulary (null).
+// Fills F's BoW slot from the descriptors of its static keypoints, unless already filled, F has
+// no static keypoint or there is no vocabulary (null). The dynamic ones are left out: a frame
+// full of people would otherwise look like every keyframe those people crossed, to the
+// relocalisation and loop candidates, and not like the room behind them.
 void computeBow(const vocabulary::Vocabulary* voc, Frame& F);
 
 }  // namespace slam
