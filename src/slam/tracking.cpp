@@ -490,6 +490,14 @@ bool Tracking::trackWhenLost(Frame& F) {
       ref_kf_ = kf;
       return true;
     }
+    // The camera moved on while people hid the room (lost for tens of frames: tens of
+    // centimetres, degrees): the last good pose is too far for the optimisation to start from,
+    // so the pose comes from PnP on the keyframe's matches, as a relocalisation near the place
+    // where tracking was lost, which also needs fewer inliers than one over the whole map.
+    if (relocalizeOn(F, kf, kLostMinMapMatches)) {
+      acceptRelocalization(F, kf);
+      return true;
+    }
   }
   return false;
 }
@@ -508,18 +516,22 @@ bool Tracking::relocalize(Frame& F) {
   std::vector<KeyFramePtr> cands = covisibilityGroupCandidates(map_, hits);
   if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
   for (const KeyFramePtr& kf : cands) {
-    if (!relocalizeOn(F, kf)) continue;
-    ref_kf_ = kf;
-    last_reloc_frame_id_ = F.id;
-    has_velocity_ = false;
-    ++relocalizations_;
+    if (!relocalizeOn(F, kf, kRelocMinInliers)) continue;
+    acceptRelocalization(F, kf);
     return true;
   }
   clearAssociations(F);
   return false;
 }
 
-bool Tracking::relocalizeOn(Frame& F, const KeyFramePtr& kf) {
+void Tracking::acceptRelocalization(const Frame& F, const KeyFramePtr& kf) {
+  ref_kf_ = kf;
+  last_reloc_frame_id_ = F.id;
+  has_velocity_ = false;
+  ++relocalizations_;
+}
+
+bool Tracking::relocalizeOn(Frame& F, const KeyFramePtr& kf, int min_inliers) {
   computeBow(voc_.get(), kf->f);
   clearAssociations(F);
   if (matcher::searchByBow(*kf, F, kRelocBowRatio) < kMinBowMatches) return false;
@@ -529,15 +541,15 @@ bool Tracking::relocalizeOn(Frame& F, const KeyFramePtr& kf) {
   releaseOutliers(F);
   // Few inliers: look for more by projecting the candidate's points (ORB-SLAM2 window 10,
   // then 3 with the refined pose).
-  if (good < kRelocMinInliers && searchKeyFramePoints(F, *kf, kRelocWindowWide) + good >= kRelocMinInliers) {
+  if (good < min_inliers && searchKeyFramePoints(F, *kf, kRelocWindowWide) + good >= min_inliers) {
     good = optimizePose(F);
-    if (good > kRelocRetryMinInliers && good < kRelocMinInliers) {
+    if (good > kRelocRetryMinInliers && good < min_inliers) {
       for (int i = 0; i < F.N; ++i)
         if (F.points[i] && F.outlier[i]) F.points[i].reset();
-      if (searchKeyFramePoints(F, *kf, kRelocWindowNarrow) + good >= kRelocMinInliers) good = optimizePose(F);
+      if (searchKeyFramePoints(F, *kf, kRelocWindowNarrow) + good >= min_inliers) good = optimizePose(F);
     }
   }
-  if (good < kRelocMinInliers) return false;
+  if (good < min_inliers) return false;
   releaseOutliers(F);
   return true;
 }

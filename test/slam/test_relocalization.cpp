@@ -164,3 +164,39 @@ TEST(SlamRelocalization, NewMapAfterResetIgnoresOldRelocalisation) {
   EXPECT_EQ(st.resets, 1u);
   EXPECT_GE(tracked_after, 18);
 }
+
+// Lost while the camera moves on (people hid the room for a second): the last good pose is too
+// far for the reference keyframe's optimisation to start from, and a strip of the room is all
+// that shows again, too little for a relocalisation over the whole map (50 inliers). The
+// keyframes near where tracking was lost relocalise it with fewer (Tracking::trackWhenLost):
+// static_xyz tracked for 60 frames, 30 blank frames while the camera goes on, then frame 89
+// with only its left 118 columns visible.
+TEST(SlamRelocalization, LostWhileMovingRecoversNearTheLastKeyframesFromAStrip) {
+  sim::SequenceGenerator gen(test_support::staticXyz(100, 5));
+  slam::System sys(gen.camera(), test_support::plainSequentialOptions(), shippedVocabulary());
+  double stamp = 0;
+  for (size_t i = 0; i < 60; ++i) {
+    const sim::SynthFrame f = gen.frame(i);
+    stamp = f.rgb_stamp;
+    ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
+  }
+  const test_support::BlankFrame blank = test_support::blankFrame(gen.frame(0));
+  for (int k = 0; k < 30; ++k) {
+    stamp += 1.0 / 30;
+    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
+  }
+  ASSERT_EQ(sys.state(), slam::TrackingState::Lost);
+  const sim::SynthFrame f = gen.frame(89);
+  constexpr int kStripWidth = 118;
+  const cv::Rect hidden(kStripWidth, 0, f.bgr.cols - kStripWidth, f.bgr.rows);
+  cv::Mat bgr = f.bgr.clone(), depth = f.depth.clone();
+  bgr(hidden).setTo(cv::Scalar::all(0));
+  depth(hidden).setTo(0);
+  const size_t relocs_before = sys.stats().relocalizations;
+  stamp += 1.0 / 30;
+  const slam::TrackResult r = sys.trackRgbd(bgr, depth, stamp, {});
+  ASSERT_EQ(r.state, slam::TrackingState::Ok);
+  EXPECT_EQ(sys.stats().relocalizations - relocs_before, 1u);
+  const Pose gt = gen.frame(0).T_wc.inverse() * f.T_wc;
+  EXPECT_LT((gt.translation() - r.T_wc.translation()).norm(), 0.03);
+}

@@ -120,11 +120,16 @@ class Tracking {
   bool trackReferenceKeyFrame(Frame& F, const KeyFramePtr& kf, const Pose& prior, int min_inliers);
   // Projection search of kf's static points not yet matched in F, window th.
   int searchKeyFramePoints(Frame& F, const KeyFrame& kf, double th) const;
+  // Lost: a relocalisation over the whole map; else the last reference keyframe and its best
+  // covisibles, each from the last good pose and then by PnP on its BoW matches (30 inliers).
   bool trackWhenLost(Frame& F);
   // ORB-SLAM2 Relocalization: BoW candidates from the map's KeyFrameDatabase, SearchByBoW,
   // PnP RANSAC, pose optimisation, projection search for more matches; needs >= 50 inliers.
   bool relocalize(Frame& F);
-  bool relocalizeOn(Frame& F, const KeyFramePtr& kf);   // one candidate
+  // One candidate: BoW matches, PnP, at least min_inliers after the pose optimisation.
+  bool relocalizeOn(Frame& F, const KeyFramePtr& kf, int min_inliers);
+  // F was relocalised on kf: the new reference, no velocity, the stricter local-map step.
+  void acceptRelocalization(const Frame& F, const KeyFramePtr& kf);
   // PnP RANSAC on F's associations; sets the pose and keeps the inliers' associations.
   bool pnpPose(Frame& F) const;
   bool trackLocalMap(Frame& F);
