@@ -188,6 +188,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.maxJump",
       "Tracking.maxJumpDeg",
       "Tracking.maxJumpInliers",
+      "Tracking.maxJumpLocalization",
       "Tracking.maxStampGap",
       "Tracking.minFrames",
       "Tracking.motionPrior",

@@ -36,6 +36,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.maxJump", &O::max_jump, Range::closed(0, 1e6)},
       {"Tracking.maxJumpDeg", &O::max_jump_deg, Range::closed(0, 180)},
       {"Tracking.maxJumpInliers", &O::max_jump_inliers, Range::atLeast(0)},
+      {"Tracking.maxJumpLocalization", &O::max_jump_localization, Range::closed(0, 1e6)},
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
       {"Tracking.localMapFromPrediction", &O::local_map_from_prediction},
       {"Tracking.youngPointCheck", &O::young_point_check},

@@ -134,6 +134,7 @@ Tracking.motionPriorDeg: 1.5
 Tracking.maxJump: 0.125
 Tracking.maxJumpDeg: 7.5
 Tracking.maxJumpInliers: 90
+Tracking.maxJumpLocalization: 0.0625
 Tracking.maxStampGap: 0.5
 Tracking.localMapFromPrediction: 0
 Tracking.youngPointCheck: 0
@@ -303,6 +304,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(k.dropped_map_matches, 5);
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
+  EXPECT_EQ(k.max_jump_localization, 0.0625);
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
                      p.thread_nice, p.free_space_ratio),

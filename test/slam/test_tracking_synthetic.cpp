@@ -148,8 +148,9 @@ struct JumpRun {
 // static_xyz frames 0-39, then a later frame of the path whose camera lies more than kJump from
 // frame 39's, stamped one frame after frame 39: to the tracker the camera jumps within a frame.
 // Every pose is "weakly supported" (maxJumpInliers huge), so only the distance decides; the
-// motion prior (default) is on.
-JumpRun runWithJump(double max_jump) {
+// motion prior (default) is on. `localization`: the jumped frame is tracked in localization mode
+// (Tracking.maxJumpLocalization at its default applies instead of maxJump).
+JumpRun runWithJump(double max_jump, bool localization = false) {
   constexpr double kJump = 0.15;
   constexpr size_t kBefore = 40;
   sim::SequenceGenerator gen(emptyRoom(7, "", 120));
@@ -167,6 +168,8 @@ JumpRun runWithJump(double max_jump) {
     last_tracked = r.T_wc;
   }
   const double next_stamp = gen.frame(kBefore).rgb_stamp;
+  sys.waitForLocalMapping();
+  sys.setLocalizationOnly(localization);
   for (size_t j = kBefore; j < gen.size(); ++j) {
     sim::SynthFrame f = gen.frame(j);
     run.jump_m = (f.T_wc.translation() - last_true.translation()).norm();
@@ -194,6 +197,19 @@ TEST(SlamTracking, MaxJumpRefusesAPoseFarFromTheMotionModel) {
   EXPECT_EQ(off.refused, 0u);
   EXPECT_NE(on.jumped, slam::TrackingState::Ok);
   EXPECT_EQ(on.refused, 1u);
+}
+
+// In localization mode the loaded map is trusted: by default a weakly supported pose 0.15 m from
+// the prediction is refused there (Tracking.maxJumpLocalization 0.05) though maxJump is off.
+TEST(SlamTracking, LocalizationModeRefusesAJumpByDefault) {
+  ASSERT_EQ(slam::TrackingOptions().max_jump, 0.0);
+  ASSERT_EQ(slam::TrackingOptions().max_jump_localization, 0.05);
+  const JumpRun slam_mode = runWithJump(0.0, false);
+  const JumpRun localization = runWithJump(0.0, true);
+  EXPECT_EQ(slam_mode.jumped, slam::TrackingState::Ok);
+  EXPECT_EQ(slam_mode.refused, 0u);
+  EXPECT_NE(localization.jumped, slam::TrackingState::Ok);
+  EXPECT_EQ(localization.refused, 1u);
 }
 
 // A camera that moves as cameras do (translation, rotation about its axes) never trips the
