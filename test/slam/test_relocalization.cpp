@@ -72,6 +72,24 @@ JumpBack runJumpBack(slam::SystemOptions opt) {
   out.relocalizations = sys.stats().relocalizations - relocs_before;
   return out;
 }
+
+// Tracks frames 0 .. frames-1 of gen (each must track), then `blanks` blank frames a frame apart;
+// returns the last stamp.
+double trackThenBlank(slam::System& sys, const sim::SequenceGenerator& gen, size_t frames, int blanks) {
+  double stamp = 0;
+  for (size_t i = 0; i < frames; ++i) {
+    const sim::SynthFrame f = gen.frame(i);
+    stamp = f.rgb_stamp;
+    EXPECT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
+  }
+  const test_support::BlankFrame blank = test_support::blankFrame(gen.frame(0));
+  for (int k = 0; k < blanks; ++k) {
+    stamp += 1.0 / 30;
+    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
+  }
+  return stamp;
+}
+
 }  // namespace
 
 TEST(SlamRelocalization, RecoversAfterBlankFramesAndJumpBack) {
@@ -106,17 +124,7 @@ TEST(SlamRelocalization, FrameAfterARelocalisationRelocalisesAtOnce) {
   so.trajectory = "loop";
   sim::SequenceGenerator gen(so);
   slam::System sys(gen.camera(), test_support::plainSequentialOptions(), shippedVocabulary());
-  double stamp = 0;
-  for (size_t i = 0; i < gen.size(); ++i) {
-    const sim::SynthFrame f = gen.frame(i);
-    stamp = f.rgb_stamp;
-    ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
-  }
-  const test_support::BlankFrame blank = test_support::blankFrame(gen.frame(0));
-  for (int k = 0; k < 3; ++k) {
-    stamp += 1.0 / 30;
-    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
-  }
+  double stamp = trackThenBlank(sys, gen, gen.size(), 3);
   ASSERT_EQ(sys.state(), slam::TrackingState::Lost);
   const size_t relocs_before = sys.stats().relocalizations;
   stamp += 1.0 / 30;
@@ -174,17 +182,7 @@ TEST(SlamRelocalization, NewMapAfterResetIgnoresOldRelocalisation) {
 TEST(SlamRelocalization, LostWhileMovingRecoversNearTheLastKeyframesFromAStrip) {
   sim::SequenceGenerator gen(test_support::staticXyz(100, 5));
   slam::System sys(gen.camera(), test_support::plainSequentialOptions(), shippedVocabulary());
-  double stamp = 0;
-  for (size_t i = 0; i < 60; ++i) {
-    const sim::SynthFrame f = gen.frame(i);
-    stamp = f.rgb_stamp;
-    ASSERT_EQ(sys.trackRgbd(f.bgr, f.depth, stamp, {}).state, slam::TrackingState::Ok) << "frame " << i;
-  }
-  const test_support::BlankFrame blank = test_support::blankFrame(gen.frame(0));
-  for (int k = 0; k < 30; ++k) {
-    stamp += 1.0 / 30;
-    sys.trackRgbd(blank.bgr, blank.depth, stamp, {});
-  }
+  double stamp = trackThenBlank(sys, gen, 60, 30);
   ASSERT_EQ(sys.state(), slam::TrackingState::Lost);
   const sim::SynthFrame f = gen.frame(89);
   constexpr int kStripWidth = 118;
