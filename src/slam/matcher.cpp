@@ -1,6 +1,7 @@
 #include "yolo_slam/slam/matcher.h"
 
 #include "yolo_slam/features/hamming.h"
+#include "yolo_slam/features/rotation_histogram.h"
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
@@ -16,7 +17,6 @@ namespace {
 
 // ORB-SLAM2 ORBmatcher values.
 constexpr int kNoMatch = 256;               // above any Hamming distance of 256-bit descriptors
-constexpr double kMinRotationShare = 0.1;   // ComputeThreeMaxima: 2nd/3rd bin vs the largest
 constexpr double kMinDistFactor = 0.8;      // isInFrustum: scale-invariance range margins
 constexpr double kMaxDistFactor = 1.2;
 constexpr double kFrontalViewCos = 0.998;   // RadiusByViewingCos: window x 2.5 when this frontal,
@@ -36,37 +36,6 @@ inline int dist(const cv::Mat& mp_desc, const cv::Mat& d, int row) {
 }
 
 }  // namespace
-
-int rotationBin(float a1, float a2) {
-  float rot = a1 - a2;
-  if (rot < 0.0f) rot += 360.0f;
-  int bin = static_cast<int>(std::round(rot * (1.0f / 360.0f) * kHistLength));
-  if (bin >= kHistLength || bin < 0) bin = 0;
-  return bin;
-}
-
-std::vector<size_t> rotationOutliers(const std::vector<std::vector<size_t>>& hist) {
-  // Three largest bins; the 2nd/3rd are kept only if they hold >= 10% of the largest.
-  int m1 = 0, m2 = 0, m3 = 0, i1 = -1, i2 = -1, i3 = -1;
-  for (int i = 0; i < static_cast<int>(hist.size()); ++i) {
-    int s = static_cast<int>(hist[i].size());
-    if (s > m1) {
-      m3 = m2; i3 = i2; m2 = m1; i2 = i1; m1 = s; i1 = i;
-    } else if (s > m2) {
-      m3 = m2; i3 = i2; m2 = s; i2 = i;
-    } else if (s > m3) {
-      m3 = s; i3 = i;
-    }
-  }
-  if (m2 < kMinRotationShare * m1) i2 = i3 = -1;
-  else if (m3 < kMinRotationShare * m1) i3 = -1;
-  std::vector<size_t> out;
-  for (int i = 0; i < static_cast<int>(hist.size()); ++i) {
-    if (i == i1 || i == i2 || i == i3) continue;
-    out.insert(out.end(), hist[i].begin(), hist[i].end());
-  }
-  return out;
-}
 
 bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, Projection& out) {
   if (!mp || mp->bad) return false;
@@ -91,7 +60,7 @@ bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, 
 
 int searchLastFrame(Frame& F, const Frame& last, double th) {
   int n = 0;
-  std::vector<std::vector<size_t>> hist(kHistLength);
+  features::RotationHistogram hist;
   std::vector<size_t> matched_idx;
   const Pose T_lc = last.T_cw * F.T_cw.inverse();
   const double tz = T_lc.inverse().translation().z();  // ORB-SLAM2 tlc(2)
@@ -128,10 +97,10 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
     if (best <= kThHigh && best_idx >= 0) {
       F.points[best_idx] = mp;
       ++n;
-      hist[rotationBin(last.kps[i].angle, F.kps[best_idx].angle)].push_back(best_idx);
+      hist.add(last.kps[i].angle, F.kps[best_idx].angle, best_idx);
     }
   }
-  for (size_t idx : rotationOutliers(hist)) {
+  for (size_t idx : hist.outliers()) {
     F.points[idx].reset();
     --n;
   }
@@ -228,7 +197,7 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
 
 int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
   int n = 0;
-  std::vector<std::vector<size_t>> hist(kHistLength);
+  features::RotationHistogram hist;
   std::vector<bool> taken(F.N, false);
   auto it1 = kf.f.bow.features.begin(), end1 = kf.f.bow.features.end();
   auto it2 = F.bow.features.begin(), end2 = F.bow.features.end();
@@ -253,7 +222,7 @@ int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
         if (best_idx >= 0 && best <= kThLow && best < nn_ratio * best2) {
           F.points[best_idx] = mp;
           taken[best_idx] = true;
-          hist[rotationBin(kf.f.kps[i1].angle, F.kps[best_idx].angle)].push_back(best_idx);
+          hist.add(kf.f.kps[i1].angle, F.kps[best_idx].angle, best_idx);
           ++n;
         }
       }
@@ -265,7 +234,7 @@ int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
       it2 = F.bow.features.lower_bound(it1->first);
     }
   }
-  for (size_t idx : rotationOutliers(hist)) {
+  for (size_t idx : hist.outliers()) {
     F.points[idx].reset();
     --n;
   }
@@ -318,10 +287,10 @@ std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf
       match12[i] = best_idx;
     }
   }
-  std::vector<std::vector<size_t>> hist(kHistLength);
+  features::RotationHistogram hist;
   for (int i = 0; i < kf1.f.N; ++i)
-    if (match12[i] >= 0) hist[rotationBin(kf1.f.kps[i].angle, kf2.f.kps[match12[i]].angle)].push_back(i);
-  for (size_t i : rotationOutliers(hist)) match12[i] = -1;
+    if (match12[i] >= 0) hist.add(kf1.f.kps[i].angle, kf2.f.kps[match12[i]].angle, i);
+  for (size_t i : hist.outliers()) match12[i] = -1;
   std::vector<std::pair<size_t, size_t>> out;
   for (int i = 0; i < kf1.f.N; ++i)
     if (match12[i] >= 0) out.emplace_back(i, match12[i]);

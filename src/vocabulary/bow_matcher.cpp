@@ -1,10 +1,10 @@
 #include "yolo_slam/vocabulary/bow_matcher.h"
 
 #include "yolo_slam/common/error.h"
+#include "yolo_slam/features/rotation_histogram.h"
 #include "yolo_slam/vocabulary/descriptor.h"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 namespace yolo_slam {
@@ -26,6 +26,34 @@ void checkSide(const BowSide& s, const char* name, bool need_kps) {
       if (i >= rows) throw Error(n + ": feature vector index " + std::to_string(i) + " out of range");
 }
 
+// The usable features of A under one vocabulary node against the free usable ones of B under
+// the same node: best and second-best distance, th_low and the ratio test.
+void matchNode(const BowSide& a, const std::vector<unsigned>& node_a, const BowSide& b,
+               const std::vector<unsigned>& node_b, const BowMatchOptions& opt, std::vector<uint8_t>& b_taken,
+               std::vector<BowMatch>& matches) {
+  for (unsigned fa : node_a) {
+    if (a.usable && !(*a.usable)[fa]) continue;
+    const uint8_t* da = a.descriptors->ptr<uint8_t>(static_cast<int>(fa));
+    int best = 256, second = 256;
+    unsigned best_b = 0;
+    for (unsigned fb : node_b) {
+      if (b_taken[fb] || (b.usable && !(*b.usable)[fb])) continue;
+      const int d = descriptorDistance(da, b.descriptors->ptr<uint8_t>(static_cast<int>(fb)));
+      if (d < best) {
+        second = best;
+        best = d;
+        best_b = fb;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best <= opt.th_low && static_cast<float>(best) < opt.nn_ratio * static_cast<float>(second)) {
+      b_taken[best_b] = 1;
+      matches.push_back({fa, best_b, best});
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<BowMatch> searchByBow(const BowSide& a, const BowSide& b, const BowMatchOptions& opt) {
@@ -44,56 +72,20 @@ std::vector<BowMatch> searchByBow(const BowSide& a, const BowSide& b, const BowM
       ib = b.fv->lower_bound(ia->first);
       continue;
     }
-    for (unsigned fa : ia->second) {
-      if (a.usable && !(*a.usable)[fa]) continue;
-      const uint8_t* da = a.descriptors->ptr<uint8_t>(static_cast<int>(fa));
-      int best = 256, second = 256;
-      unsigned best_b = 0;
-      for (unsigned fb : ib->second) {
-        if (b_taken[fb] || (b.usable && !(*b.usable)[fb])) continue;
-        const int d = descriptorDistance(da, b.descriptors->ptr<uint8_t>(static_cast<int>(fb)));
-        if (d < best) {
-          second = best;
-          best = d;
-          best_b = fb;
-        } else if (d < second) {
-          second = d;
-        }
-      }
-      if (best <= opt.th_low && static_cast<float>(best) < opt.nn_ratio * static_cast<float>(second)) {
-        b_taken[best_b] = 1;
-        matches.push_back({fa, best_b, best});
-      }
-    }
+    matchNode(a, ia->second, b, ib->second, opt, b_taken, matches);
     ++ia;
     ++ib;
   }
 
   if (opt.check_orientation && !matches.empty() && opt.histogram_bins > 0) {
-    const int bins = opt.histogram_bins;
-    const float factor = static_cast<float>(bins) / 360.0f;
-    std::vector<int> bin_of(matches.size());
-    std::vector<int> count(bins, 0);
-    for (size_t i = 0; i < matches.size(); ++i) {
-      float rot = (*a.keypoints)[matches[i].a].angle - (*b.keypoints)[matches[i].b].angle;
-      if (rot < 0) rot += 360.0f;
-      int bin = static_cast<int>(std::lround(rot * factor));
-      if (bin >= bins) bin = 0;  // 360 degrees wraps to 0
-      if (bin < 0) bin = 0;
-      bin_of[i] = bin;
-      ++count[bin];
-    }
-    // The three largest bins; the second and third only if they hold >= 10% of the largest.
-    std::vector<int> order(bins);
-    for (int i = 0; i < bins; ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return count[x] > count[y]; });
-    std::vector<uint8_t> keep(bins, 0);
-    keep[order[0]] = 1;
-    for (int r = 1; r < std::min(3, bins); ++r)
-      if (count[order[r]] > 0 && count[order[r]] >= 0.1 * count[order[0]]) keep[order[r]] = 1;
+    features::RotationHistogram hist(opt.histogram_bins);
+    for (size_t i = 0; i < matches.size(); ++i)
+      hist.add((*a.keypoints)[matches[i].a].angle, (*b.keypoints)[matches[i].b].angle, i);
+    std::vector<uint8_t> drop(matches.size(), 0);
+    for (size_t i : hist.outliers()) drop[i] = 1;
     std::vector<BowMatch> kept;
     for (size_t i = 0; i < matches.size(); ++i)
-      if (keep[bin_of[i]]) kept.push_back(matches[i]);
+      if (!drop[i]) kept.push_back(matches[i]);
     matches.swap(kept);
   }
   std::sort(matches.begin(), matches.end(), [](const BowMatch& x, const BowMatch& y) { return x.a < y.a; });

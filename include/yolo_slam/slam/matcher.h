@@ -21,7 +21,6 @@ constexpr int kThLow = features::kOrbHammingLow;
 // searchProjections reports a map point as on a moving object only if the dynamic keypoint it
 // matches is within this fraction of the point's predicted depth (a nearer keypoint hides it).
 constexpr double kDynamicDepthTolerance = 0.1;
-constexpr int kHistLength = 30;   // rotation histogram bins (ORB-SLAM2 HISTO_LENGTH)
 
 // A map point projected into a frame (ORB-SLAM2 isInFrustum results).
 struct Projection {
@@ -76,11 +75,6 @@ std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf
 // Projects `points` into `kf` and fuses duplicates (ORB-SLAM2 Fuse): the point with fewer
 // observations is replaced by the other, or a new observation is added. Returns fused count.
 int fuse(Map& map, const KeyFramePtr& kf, const std::vector<MapPointPtr>& points, double th = 3.0);
-
-// Keeps only the matches in the three dominant rotation bins (ORB-SLAM2 ComputeThreeMaxima);
-// `rot_hist[b]` lists match ids, the ids of the rejected ones are returned.
-std::vector<size_t> rotationOutliers(const std::vector<std::vector<size_t>>& rot_hist);
-int rotationBin(float angle1, float angle2);
 
 }  // namespace matcher
 }  // namespace slam

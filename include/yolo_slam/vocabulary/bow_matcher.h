@@ -3,8 +3,7 @@
 // features under the same vocabulary node are compared. For each usable feature of side A the
 // best and second-best usable, not yet matched feature of side B under that node are found; a
 // match is kept if best <= th_low and best < nn_ratio * second. Optionally the matches are
-// filtered for rotation consistency (histogram of keypoint angle differences, 30 bins, keep
-// the three largest bins; a bin is dropped if below 10% of the largest).
+// filtered for rotation consistency (features::RotationHistogram with histogram_bins bins).
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/vocabulary/bow_vector.h"
 
