@@ -5,6 +5,7 @@
 #include "yolo_slam/slam/keyframe.h"
 #include "yolo_slam/slam/map.h"
 #include "yolo_slam/slam/map_point.h"
+#include "yolo_slam/vocabulary/bow_matcher.h"
 
 #include <algorithm>
 #include <cmath>
@@ -196,49 +197,21 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
 }
 
 int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio) {
-  int n = 0;
-  features::RotationHistogram hist;
-  std::vector<bool> taken(F.N, false);
-  auto it1 = kf.f.bow.features.begin(), end1 = kf.f.bow.features.end();
-  auto it2 = F.bow.features.begin(), end2 = F.bow.features.end();
-  while (it1 != end1 && it2 != end2) {
-    if (it1->first == it2->first) {
-      for (unsigned i1 : it1->second) {
-        if (i1 >= kf.f.points.size()) continue;
-        const MapPointPtr& mp = kf.f.points[i1];
-        if (!mp || mp->bad || mp->dynamic) continue;
-        int best = kNoMatch, best2 = kNoMatch, best_idx = -1;
-        for (unsigned i2 : it2->second) {
-          if (i2 >= static_cast<unsigned>(F.N) || taken[i2] || F.dynamic[i2]) continue;
-          int d = dist(kf.f.descriptors, static_cast<int>(i1), F.descriptors, static_cast<int>(i2));
-          if (d < best) {
-            best2 = best;
-            best = d;
-            best_idx = static_cast<int>(i2);
-          } else if (d < best2) {
-            best2 = d;
-          }
-        }
-        if (best_idx >= 0 && best <= kThLow && best < nn_ratio * best2) {
-          F.points[best_idx] = mp;
-          taken[best_idx] = true;
-          hist.add(kf.f.kps[i1].angle, F.kps[best_idx].angle, best_idx);
-          ++n;
-        }
-      }
-      ++it1;
-      ++it2;
-    } else if (it1->first < it2->first) {
-      it1 = kf.f.bow.features.lower_bound(it2->first);
-    } else {
-      it2 = F.bow.features.lower_bound(it1->first);
-    }
+  std::vector<uint8_t> kf_usable(static_cast<size_t>(kf.f.descriptors.rows), 0);
+  for (size_t i = 0; i < kf_usable.size() && i < kf.f.points.size(); ++i) {
+    const MapPointPtr& mp = kf.f.points[i];
+    kf_usable[i] = mp && !mp->bad && !mp->dynamic;
   }
-  for (size_t idx : hist.outliers()) {
-    F.points[idx].reset();
-    --n;
-  }
-  return n;
+  std::vector<uint8_t> f_usable(static_cast<size_t>(F.descriptors.rows), 0);
+  for (size_t i = 0; i < f_usable.size() && i < F.dynamic.size(); ++i) f_usable[i] = !F.dynamic[i];
+  const vocabulary::BowSide a{&kf.f.bow.features, &kf.f.descriptors, &kf.f.kps, &kf_usable};
+  const vocabulary::BowSide b{&F.bow.features, &F.descriptors, &F.kps, &f_usable};
+  vocabulary::BowMatchOptions opt;
+  opt.th_low = kThLow;
+  opt.nn_ratio = static_cast<float>(nn_ratio);
+  const std::vector<vocabulary::BowMatch> matches = vocabulary::searchByBow(a, b, opt);
+  for (const vocabulary::BowMatch& m : matches) F.points[m.b] = kf.f.points[m.a];
+  return static_cast<int>(matches.size());
 }
 
 std::vector<std::pair<size_t, size_t>> searchForTriangulation(const KeyFrame& kf1,

@@ -61,8 +61,9 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
                       std::vector<MapPointPtr>* dynamic_hits = nullptr,
                       const DroppedMatching* dropped = nullptr);
 
-// BoW search between a keyframe and a frame (ORB-SLAM2 SearchByBoW) through their
-// FeatureVectors; requires both BoW slots filled. Matches written into F.points.
+// BoW search between a keyframe and a frame (ORB-SLAM2 SearchByBoW, vocabulary::searchByBow):
+// the keyframe's keypoints with a good static map point against F's static keypoints; requires
+// both BoW slots filled. Matches written into F.points; returns their number.
 int searchByBow(const KeyFrame& kf, Frame& F, double nn_ratio = 0.7);
 
 // Candidate pairs (idx1, idx2) for triangulation between two keyframes: unmatched static
