@@ -438,7 +438,11 @@ RunSetup setUp(const Args& args) {
 }
 
 void detectInto(const RunSetup& r, Prepared& p) {
-  if (!r.stages.detection || r.async || !p.has_image) return;
+  if (!r.stages.detection || !p.has_image) return;
+  if (r.async) {
+    r.async->offer(p.bgr, static_cast<long>(p.index), p.stamp);
+    return;
+  }
   p.detected_image = static_cast<long>(p.index);
   if (!r.detector) {
     auto it = r.file_boxes.find(std::llround(p.stamp * 1e6));
@@ -674,14 +678,15 @@ std::string frameLine(const Prepared& p, const char* state, const slam::TrackRes
   return line;
 }
 
-// Async detection: offers the frame to the detector and screens it with the newest result if
-// it is fresh and recent; otherwise with no detection (the box tracker carries earlier boxes).
+// Async detection (the frame was offered to the detector as it arrived, detectInto): screens
+// the frame with the newest result of it or an earlier frame if that is fresh and recent;
+// otherwise with no detection (the box tracker carries earlier boxes).
 void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared& p, slam::System& system,
                       LoopResult& res) {
   if (!setup.async || !p.has_image) return;
-  setup.async->offer(p.bgr, static_cast<long>(p.index), p.stamp);
-  if (setup.max_lag_frames > 0) setup.async->waitForFrame(static_cast<long>(p.index) - setup.max_lag_frames);
-  const std::optional<detection::DetectionResult> newest = setup.async->newest();
+  const long index = static_cast<long>(p.index);
+  if (setup.max_lag_frames > 0) setup.async->waitForFrame(index - setup.max_lag_frames);
+  const std::optional<detection::DetectionResult> newest = setup.async->newestUpTo(index);
   const long expired_before = feed.expired();
   const detection::FrameBoxes fb = feed.take(newest, p.stamp);
   res.boxes_expired += feed.expired() - expired_before;
@@ -806,8 +811,8 @@ class AheadStage {
 // unless --sequential, frame t+1 is then extracted (System::extractFrame) while the frame loop
 // screens and tracks frame t. With --sequential the frame loop extracts, so the feature budget
 // follows the frame just screened and two runs are identical. The asynchronous detector is
-// offered a frame by the frame loop, when the frame is screened: Detection.asyncMaxLag counts
-// frames screened.
+// offered a frame in the detection stage, as the frame arrives (a camera's detector sees the
+// newest image, not the one being screened); Detection.asyncMaxLag counts frames screened.
 template <class Source>
 void runFrames(Source& source, const RunSetup& setup, slam::System& system, PartialOutputs& outputs,
                LoopResult& res) {

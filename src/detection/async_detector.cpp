@@ -11,6 +11,12 @@
 namespace yolo_slam {
 namespace detection {
 
+namespace {
+// Results kept for newestUpTo: a frame offered as it arrives is at most a few frames ahead of the
+// frame being screened, and one detection takes longer than a frame.
+constexpr size_t kRecentResults = 4;
+}  // namespace
+
 AsyncDetectionOptions AsyncDetectionOptions::load(const Config& cfg) {
   AsyncDetectionOptions o;
   o.enabled = cfg.getBool("Detection.async", o.enabled);
@@ -57,7 +63,15 @@ void AsyncDetector::offer(const cv::Mat& bgr, long index, double stamp) {
 
 std::optional<DetectionResult> AsyncDetector::newest() const {
   std::lock_guard<std::mutex> lk(mutex_);
-  return newest_;
+  if (recent_.empty()) return std::nullopt;
+  return recent_.back();
+}
+
+std::optional<DetectionResult> AsyncDetector::newestUpTo(long index) const {
+  std::lock_guard<std::mutex> lk(mutex_);
+  for (auto it = recent_.rbegin(); it != recent_.rend(); ++it)
+    if (it->frame <= index) return *it;
+  return std::nullopt;
 }
 
 void AsyncDetector::waitIdle() {
@@ -67,7 +81,7 @@ void AsyncDetector::waitIdle() {
 
 bool AsyncDetector::waitForFrame(long index) {
   std::unique_lock<std::mutex> lk(mutex_);
-  const auto arrived = [this, index] { return newest_ && newest_->frame >= index; };
+  const auto arrived = [this, index] { return !recent_.empty() && recent_.back().frame >= index; };
   cv_.wait(lk, [&] { return stop_ || arrived() || (!pending_ && !busy_); });
   return arrived();
 }
@@ -106,7 +120,8 @@ void AsyncDetector::run() {
     lk.lock();
     busy_ = false;
     ++counts_.detected;
-    newest_ = std::move(r);
+    recent_.push_back(std::move(r));
+    if (recent_.size() > kRecentResults) recent_.pop_front();
     cv_.notify_all();
   }
 }

@@ -125,6 +125,30 @@ TEST(AsyncDetector, WaitForFrameReturnsOnceAResultThatRecentIsThere) {
   EXPECT_FALSE(async.waitForFrame(9));
 }
 
+// Frames are offered as they arrive, ahead of the frame being screened: that frame must never
+// get the boxes of a later image.
+TEST(AsyncDetector, NewestUpToNeverHandsAFrameTheResultOfALaterOne) {
+  AsyncDetector async(std::make_unique<InstantDetector>());
+  EXPECT_FALSE(async.newestUpTo(10).has_value());
+  for (long i : {2, 4, 6}) {
+    async.offer(imageOf(static_cast<int>(i)), i, i / 30.0);
+    async.waitIdle();
+  }
+  EXPECT_FALSE(async.newestUpTo(1).has_value());
+  EXPECT_EQ(async.newestUpTo(3)->frame, 2);
+  EXPECT_EQ(async.newestUpTo(5)->frame, 4);
+  EXPECT_EQ(async.newestUpTo(6)->frame, 6);
+  EXPECT_EQ(async.newestUpTo(100)->frame, 6);
+  EXPECT_EQ(async.newest()->frame, 6);
+  // Only the last few results are kept: far behind the detector there is nothing to hand out.
+  for (long i = 7; i < 20; ++i) {
+    async.offer(imageOf(static_cast<int>(i)), i, i / 30.0);
+    async.waitIdle();
+  }
+  EXPECT_FALSE(async.newestUpTo(6).has_value());
+  EXPECT_EQ(async.newestUpTo(18)->frame, 18);
+}
+
 TEST(AsyncDetector, TheDetectionThreadRunsAtDetectionThreadNice) {
   const int base = getpriority(PRIO_PROCESS, 0);
   AsyncDetector async(std::make_unique<InstantDetector>(), 0, 6);

@@ -1,8 +1,9 @@
 #pragma once
 // Detection that never holds up the frame stream (as NGD-SLAM and RDS-SLAM run YOLO): a worker
 // thread detects people in the newest frame offered whenever it is free; a frame offered while
-// another still waits replaces it (no backlog). The stream takes the newest finished result
-// and uses it only while it is recent (AsyncDetectionOptions::max_age_s); between results the
+// another still waits replaces it (no backlog). Frames are offered as they arrive; a frame is
+// screened with the newest finished result of its own or an earlier image, used only while it is
+// recent (AsyncDetectionOptions::max_age_s); between results the
 // screening's box tracker carries the boxes.
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/detection/detector.h"
@@ -10,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -44,10 +46,11 @@ struct AsyncDetectionOptions {
   // busy CPU the frame stream goes first; the boxes then come less often.
   int thread_nice = 0;
   // Detection.asyncMaxLag (frames; yolo_slam_run at full speed only): a frame whose newest
-  // result is of an image more than this many frames older waits for a newer one. At full speed
-  // frames come faster than a camera's and the detector sees one in three or four: people
-  // entering the view get their box frames late. A camera (--camera-rate, --realtime, ROS)
-  // never waits: there the detector keeps up. 0: never wait.
+  // result is of an image more than this many frames older waits for a newer one (or for the
+  // detector to finish a frame that arrived after it). At full speed frames come faster than a
+  // camera's and the detector sees one in three or four: people entering the view get their
+  // boxes frames late. A camera (--camera-rate, --realtime, ROS) never waits: there the
+  // detector keeps up. 0: never wait.
   int max_lag_frames = 3;
   static AsyncDetectionOptions load(const Config& cfg);  // throws Error naming file and key
 };
@@ -76,6 +79,9 @@ class AsyncDetector {
   void offer(const cv::Mat& bgr, long index, double stamp);
   // The newest finished result, if any.
   std::optional<DetectionResult> newest() const;
+  // The newest finished result of frame `index` or earlier, if any: a frame offered as it
+  // arrives may be detected before the frames ahead of it in the pipeline are screened.
+  std::optional<DetectionResult> newestUpTo(long index) const;
   // Blocks until no frame waits and none is being detected (tests, end of a sequence).
   void waitIdle();
   // Blocks until the newest result is of frame `index` or later, or nothing more will come (no
@@ -103,7 +109,8 @@ class AsyncDetector {
   std::optional<Pending> pending_;
   std::optional<double> last_taken_stamp_;  // stamp of the newest frame the worker took
   bool busy_ = false, stop_ = false;
-  std::optional<DetectionResult> newest_;
+  // The last few results, oldest first (frames increase: the worker takes the newest offered).
+  std::deque<DetectionResult> recent_;
   AsyncDetectionCounts counts_;
   std::thread worker_;  // started last, in the constructor
 };
