@@ -26,8 +26,8 @@ namespace detection {
 struct AsyncDetectionOptions {
   // Detection.async: 1 detects asynchronously (the ROS launch files turn it on: a live camera
   // must never wait for the detector); 0 (default) detects every frame before it is screened:
-  // the paper's pipeline, the most accurate (BENCHMARKS.md: async at full speed costs up to
-  // 1.3x ATE on the walking presets, 2-3x in crowds) and, with --sequential, repeatable.
+  // the paper's pipeline, the most accurate (BENCHMARKS.md "Session 40": async at full speed
+  // 0.97-1.11x its ATE on the walking presets) and, with --sequential, repeatable.
   bool enabled = false;
   // Detection.maxAge (seconds): a result is used for a frame at most this much younger than
   // the result's own frame. People walk about 1.4 m/s: in 0.2 s a box at 2 m is off by about a
