@@ -685,7 +685,7 @@ void attachAsyncBoxes(const RunSetup& setup, detection::BoxFeed& feed, Prepared&
                       LoopResult& res) {
   if (!setup.async || !p.has_image) return;
   const long index = static_cast<long>(p.index);
-  if (setup.max_lag_frames > 0) setup.async->waitForFrame(index - setup.max_lag_frames);
+  if (setup.max_lag_frames > 0) setup.async->waitForFrameIn(index - setup.max_lag_frames, index, p.bgr, p.stamp);
   const std::optional<detection::DetectionResult> newest = setup.async->newestUpTo(index);
   const long expired_before = feed.expired();
   const detection::FrameBoxes fb = feed.take(newest, p.stamp);
@@ -877,6 +877,7 @@ Json detectionJson(const RunSetup& setup, const LoopResult& res) {
   return Json{{"mode", "async"},           {"max_age_s", setup.max_box_age_s},
               {"offered", c.offered},      {"detected", c.detected},
               {"replaced", c.replaced},    {"throttled", c.throttled},
+              {"reoffered", c.reoffered},
               {"frames_with_new_boxes", res.boxes_fresh},
               {"results_too_old", res.boxes_expired}};
 }

@@ -69,9 +69,11 @@ std::optional<DetectionResult> AsyncDetector::newest() const {
 
 std::optional<DetectionResult> AsyncDetector::newestUpTo(long index) const {
   std::lock_guard<std::mutex> lk(mutex_);
-  for (auto it = recent_.rbegin(); it != recent_.rend(); ++it)
-    if (it->frame <= index) return *it;
-  return std::nullopt;
+  const DetectionResult* best = nullptr;
+  for (const DetectionResult& r : recent_)
+    if (r.frame <= index && (!best || r.frame >= best->frame)) best = &r;
+  if (!best) return std::nullopt;
+  return *best;
 }
 
 void AsyncDetector::waitIdle() {
@@ -79,10 +81,24 @@ void AsyncDetector::waitIdle() {
   cv_.wait(lk, [this] { return stop_ || (!pending_ && !busy_); });
 }
 
-bool AsyncDetector::waitForFrame(long index) {
+bool AsyncDetector::waitForFrameIn(long first, long last, const cv::Mat& bgr, double stamp) {
+  const auto in = [first, last](long frame) { return frame >= first && frame <= last; };
   std::unique_lock<std::mutex> lk(mutex_);
-  const auto arrived = [this, index] { return !recent_.empty() && recent_.back().frame >= index; };
-  cv_.wait(lk, [&] { return stop_ || arrived() || (!pending_ && !busy_); });
+  const auto arrived = [&] {
+    return std::any_of(recent_.begin(), recent_.end(), [&](const DetectionResult& r) { return in(r.frame); });
+  };
+  const auto coming = [&] { return (pending_ && in(pending_->index)) || (busy_ && in(busy_index_)); };
+  // A newer frame offered meanwhile replaces the one offered again: offer it once more (the
+  // caller's pipeline holds only a few frames ahead, so the offers end).
+  while (!stop_ && !arrived()) {
+    if (!coming()) {
+      ++counts_.reoffered;
+      if (pending_) ++counts_.replaced;
+      pending_ = Pending{bgr, last, stamp};
+      cv_.notify_all();
+    }
+    cv_.wait(lk, [&] { return stop_ || arrived() || !coming(); });
+  }
   return arrived();
 }
 
@@ -106,6 +122,7 @@ void AsyncDetector::run() {
     pending_.reset();
     last_taken_stamp_ = job.stamp;
     busy_ = true;
+    busy_index_ = job.index;
     lk.unlock();
     DetectionResult r;
     r.frame = job.index;

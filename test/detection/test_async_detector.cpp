@@ -102,7 +102,7 @@ TEST(AsyncDetector, AMinimumIntervalKeepsFramesFromTheDetector) {
   EXPECT_EQ(async.newest()->frame, 30);
 }
 
-TEST(AsyncDetector, WaitForFrameReturnsOnceAResultThatRecentIsThere) {
+TEST(AsyncDetector, WaitForFrameInReturnsOnceAResultThatRecentIsThere) {
   auto gated = std::make_unique<GatedDetector>();
   GatedDetector* gate = gated.get();
   AsyncDetector async(std::move(gated));
@@ -110,7 +110,7 @@ TEST(AsyncDetector, WaitForFrameReturnsOnceAResultThatRecentIsThere) {
   std::atomic<bool> returned{false};
   bool got = false;
   std::thread waiter([&] {
-    got = async.waitForFrame(4);
+    got = async.waitForFrameIn(4, 6, imageOf(6), 0.2);
     returned = true;
   });
   while (gate->started() < 1) std::this_thread::yield();
@@ -120,9 +120,34 @@ TEST(AsyncDetector, WaitForFrameReturnsOnceAResultThatRecentIsThere) {
   waiter.join();
   EXPECT_TRUE(got);
   EXPECT_EQ(async.newest()->frame, 5);
-  EXPECT_TRUE(async.waitForFrame(5));  // already there: no wait
-  // Nothing newer is queued or detected: the wait ends without the result it asked for.
-  EXPECT_FALSE(async.waitForFrame(9));
+  EXPECT_TRUE(async.waitForFrameIn(5, 9, imageOf(9), 0.3));  // already there: no wait
+  EXPECT_EQ(async.counts().reoffered, 0);
+}
+
+// The detector took a later frame than the one waiting (frames are offered as they arrive): the
+// waiting frame is offered again rather than screened with boxes older than the lag allows.
+TEST(AsyncDetector, WaitForFrameInOffersAFrameTheDetectorSkippedAgain) {
+  auto gated = std::make_unique<GatedDetector>();
+  GatedDetector* gate = gated.get();
+  AsyncDetector async(std::move(gated));
+  async.offer(imageOf(0), 0, 0.0);
+  while (gate->started() < 1) std::this_thread::yield();  // frame 0 is being detected
+  async.offer(imageOf(1), 1, 1 / 30.0);
+  async.offer(imageOf(2), 2, 2 / 30.0);  // replaces frame 1: the detector will take frame 2
+  bool got = false;
+  std::thread waiter([&] { got = async.waitForFrameIn(1, 1, imageOf(1), 1 / 30.0); });
+  while (async.counts().reoffered < 1) std::this_thread::yield();  // frame 1 waits again
+  gate->open();
+  waiter.join();
+  EXPECT_TRUE(got);
+  EXPECT_EQ(async.newestUpTo(1)->frame, 1);
+  EXPECT_FLOAT_EQ(async.newestUpTo(1)->boxes.at(0).rect.x, 1.f);
+  async.waitIdle();
+  const AsyncDetectionCounts c = async.counts();
+  EXPECT_EQ(c.offered, 3);
+  EXPECT_EQ(c.reoffered, 1);
+  EXPECT_EQ(c.detected, 2);  // frames 0 and 1; frame 2 gave way to the frame offered again
+  EXPECT_EQ(c.detected + c.replaced, c.offered + c.reoffered);
 }
 
 // Frames are offered as they arrive, ahead of the frame being screened: that frame must never

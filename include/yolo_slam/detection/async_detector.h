@@ -45,9 +45,9 @@ struct AsyncDetectionOptions {
   // detection: the offline runner's worker, the Detector nodelet's own thread), so that on a
   // busy CPU the frame stream goes first; the boxes then come less often.
   int thread_nice = 0;
-  // Detection.asyncMaxLag (frames; yolo_slam_run at full speed only): a frame whose newest
-  // result is of an image more than this many frames older waits for a newer one (or for the
-  // detector to finish a frame that arrived after it). At full speed frames come faster than a
+  // Detection.asyncMaxLag (frames; yolo_slam_run at full speed only): a frame without a result
+  // of an image at most this many frames older waits for one (AsyncDetector::waitForFrameIn
+  // offers it again when the detector took a later frame). At full speed frames come faster than a
   // camera's and the detector sees one in three or four: people entering the view get their
   // boxes frames late. A camera (--camera-rate, --realtime, ROS) never waits: there the
   // detector keeps up. 0: never wait.
@@ -66,6 +66,7 @@ struct DetectionResult {
 struct AsyncDetectionCounts {
   long offered = 0, detected = 0, replaced = 0;  // replaced: offered, never detected
   long throttled = 0;  // offered within min_interval_s of the last frame taken: not queued
+  long reoffered = 0;  // offered again by waitForFrameIn (not in `offered`)
 };
 
 class AsyncDetector {
@@ -84,9 +85,10 @@ class AsyncDetector {
   std::optional<DetectionResult> newestUpTo(long index) const;
   // Blocks until no frame waits and none is being detected (tests, end of a sequence).
   void waitIdle();
-  // Blocks until the newest result is of frame `index` or later, or nothing more will come (no
-  // frame waits or is being detected); returns whether such a result is there.
-  bool waitForFrame(long index);
+  // Blocks until a result of a frame in [first, last] is there; when none is there, waiting or
+  // being detected (the detector took a later frame), `bgr`, frame `last`, is offered again
+  // first. Returns whether such a result is there (false only when stopping).
+  bool waitForFrameIn(long first, long last, const cv::Mat& bgr, double stamp);
   AsyncDetectionCounts counts() const;
   const Detector& detector() const { return *detector_; }
 
@@ -109,7 +111,9 @@ class AsyncDetector {
   std::optional<Pending> pending_;
   std::optional<double> last_taken_stamp_;  // stamp of the newest frame the worker took
   bool busy_ = false, stop_ = false;
-  // The last few results, oldest first (frames increase: the worker takes the newest offered).
+  long busy_index_ = -1;  // the frame being detected while busy_
+  // The last few results in the order they were made (frames increase, except for a frame
+  // offered again by waitForFrameIn).
   std::deque<DetectionResult> recent_;
   AsyncDetectionCounts counts_;
   std::thread worker_;  // started last, in the constructor
