@@ -3,8 +3,8 @@
 // thread detects people in the newest frame offered whenever it is free; a frame offered while
 // another still waits replaces it (no backlog). Frames are offered as they arrive; a frame is
 // screened with the newest finished result of its own or an earlier image, used only while it is
-// recent (AsyncDetectionOptions::max_age_s); between results the
-// screening's box tracker carries the boxes.
+// recent (AsyncDetectionOptions::max_age_s); between results the screening's box tracker
+// carries the boxes.
 #include "yolo_slam/detection/box.h"
 #include "yolo_slam/detection/detector.h"
 
@@ -64,7 +64,7 @@ struct DetectionResult {
 };
 
 struct AsyncDetectionCounts {
-  long offered = 0, detected = 0, replaced = 0;  // replaced: offered, never detected
+  long offered = 0, detected = 0, replaced = 0;  // replaced: offered (or reoffered), never detected
   long throttled = 0;  // offered within min_interval_s of the last frame taken: not queued
   long reoffered = 0;  // offered again by waitForFrameIn (not in `offered`)
 };
