@@ -169,7 +169,9 @@ bool Tracking::trackFrame(Frame& F) {
   bool ok = false, from_prediction = false;
   const bool predicted = state_ == TrackingState::Ok && has_last_ && has_velocity_;
   const Pose prediction = predicted ? Pose(velocity_ * last_.T_cw) : Pose::Identity();
-  if (predicted && opt_.motion_prior > 0) prior_ = motionPrior(F, prediction);
+  // Right after a relocalisation the velocity measures the relocalised pose's correction, not the
+  // camera's motion: a prior would hold on to it.
+  if (predicted && opt_.motion_prior > 0 && !justRelocalized(F)) prior_ = motionPrior(F, prediction);
   if (state_ == TrackingState::Ok && has_last_) {
     if (has_velocity_) ok = trackMotionModel(F);
     if (!ok && ref_kf_ && !ref_kf_->bad)
@@ -703,9 +705,12 @@ bool Tracking::trackLocalMap(Frame& F) {
   return ok;
 }
 
+bool Tracking::justRelocalized(const Frame& F) const {
+  return last_reloc_frame_id_ >= 0 && F.id < last_reloc_frame_id_ + max_frames_;
+}
+
 int Tracking::minInliers(const Frame& F) const {
-  const bool after_reloc = last_reloc_frame_id_ >= 0 && F.id < last_reloc_frame_id_ + max_frames_;
-  return after_reloc ? std::max(opt_.min_inliers, opt_.reloc_min_inliers) : opt_.min_inliers;
+  return justRelocalized(F) ? std::max(opt_.min_inliers, opt_.reloc_min_inliers) : opt_.min_inliers;
 }
 
 int Tracking::dropDisagreeingYoungPoints(Frame& F) {
@@ -720,8 +725,7 @@ bool Tracking::needNewKeyFrame(const Frame& F) const {
   if (!mapper_ || mapper_->paused()) return false;
   const int n_kfs = static_cast<int>(map_.numKeyFrames());
   // Right after a relocalisation the pose rests on few points: wait (ORB-SLAM2).
-  if (last_reloc_frame_id_ >= 0 && F.id < last_reloc_frame_id_ + max_frames_ && n_kfs > max_frames_)
-    return false;
+  if (justRelocalized(F) && n_kfs > max_frames_) return false;
   const int min_obs = n_kfs <= 2 ? 2 : 3;
   KeyFramePtr ref = ref_kf_;
   const int ref_matches = ref && !ref->bad ? ref->trackedMapPoints(min_obs) : 0;

@@ -185,15 +185,17 @@ JumpRun runWithJump(double max_jump, bool localization = false) {
 
 }  // namespace
 
-// Off, the tracker follows the jump in full (the motion prior, sigma 2 cm, does not hold back a
-// pose that hundreds of points pin down); with Tracking.maxJump 0.1 m the pose is refused.
+// Off, the tracker follows the jump: the motion prior (sigma 5 mm a frame) holds a 15 cm jump
+// within one frame, 30 sigmas and beyond any real camera's, back by 2 cm (measured 130 of 150 mm);
+// with Tracking.maxJump 0.1 m the pose is refused.
 TEST(SlamTracking, MaxJumpRefusesAPoseFarFromTheMotionModel) {
+  constexpr double kHeldBackM = 0.03;
   const JumpRun off = runWithJump(0.0);
   const JumpRun on = runWithJump(0.1);
   std::printf("camera jump %.3f m: maxJump 0 -> %s, tracked %.3f m; 0.1 -> %s (%zu refused)\n", on.jump_m,
               slam::toString(off.jumped), off.tracked_m, slam::toString(on.jumped), on.refused);
   EXPECT_EQ(off.jumped, slam::TrackingState::Ok);
-  EXPECT_NEAR(off.tracked_m, off.jump_m, 0.01);
+  EXPECT_NEAR(off.tracked_m, off.jump_m, kHeldBackM);
   EXPECT_EQ(off.refused, 0u);
   EXPECT_NE(on.jumped, slam::TrackingState::Ok);
   EXPECT_EQ(on.refused, 1u);

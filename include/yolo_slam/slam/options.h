@@ -54,8 +54,12 @@ struct TrackingOptions {
   // Gaussian prior at the constant-velocity prediction, sigma motionPrior metres for the camera
   // centre and motionPriorDeg degrees, times the frames since the last one. Strong static
   // support outweighs it; it holds the directions a sliver of far static scene (people filling
-  // the view) leaves unconstrained. 0 = off.
-  double motion_prior = 0.02;       // Tracking.motionPrior (m)
+  // the view) leaves unconstrained. Both sigmas sit near the 95th percentile of how far the real
+  // fr3_walking_xyz camera moves from the prediction in a frame (3.9 mm, 1.06 degrees): where a
+  // far wall cannot tell a sideways shift from a turn, the prior then favours neither (test
+  // MotionPrior.*; with 2 cm a crowd's sideways walk became a turn: BENCHMARKS.md, "Session
+  // 41"). 0 = off.
+  double motion_prior = 0.005;      // Tracking.motionPrior (m)
   double motion_prior_deg = 1.0;    // Tracking.motionPriorDeg
   // maxJump > 0: a pose that lands more than maxJump metres (or maxJumpDeg degrees) from the
   // constant-velocity prediction on fewer than maxJumpInliers inliers is refused (the frame

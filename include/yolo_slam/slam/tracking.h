@@ -113,6 +113,8 @@ class Tracking {
   // Tracking.localMapFromPrediction: F starts at `prediction` without associations, so that
   // trackLocalMap searches the last frame's local map from there.
   void startFromPrediction(Frame& F, const Pose& prediction) const;
+  // Whether F comes within max_frames_ (a second) of the last relocalisation (ORB-SLAM2's window).
+  bool justRelocalized(const Frame& F) const;
   // Inliers the local-map step needs: Tracking.relocMinInliers shortly after a relocalisation.
   int minInliers(const Frame& F) const;
   // Whether a new keyframe may make a map point of keypoint i (Tracking.boxedPointsStaticOnly).
