@@ -99,14 +99,21 @@ Frame::Frame(const features::FeatureFrame& ff, const CameraModel& camera, const 
 std::vector<size_t> Frame::featuresInArea(double x, double y, double r, int min_level,
                                           int max_level, bool dynamic_only) const {
   std::vector<size_t> out;
-  if (grid_.empty() || !std::isfinite(x) || !std::isfinite(y)) return out;
+  featuresInArea(out, x, y, r, min_level, max_level, dynamic_only);
+  return out;
+}
+
+void Frame::featuresInArea(std::vector<size_t>& out, double x, double y, double r, int min_level,
+                           int max_level, bool dynamic_only) const {
+  out.clear();
+  if (grid_.empty() || !std::isfinite(x) || !std::isfinite(y)) return;
   const int c0 = std::max(0, static_cast<int>(std::floor((x - geom.min_x - r) * geom.inv_cell_w)));
   const int c1 = std::min(FrameGeometry::kGridCols - 1,
                           static_cast<int>(std::ceil((x - geom.min_x + r) * geom.inv_cell_w)));
   const int r0 = std::max(0, static_cast<int>(std::floor((y - geom.min_y - r) * geom.inv_cell_h)));
   const int r1 = std::min(FrameGeometry::kGridRows - 1,
                           static_cast<int>(std::ceil((y - geom.min_y + r) * geom.inv_cell_h)));
-  if (c0 >= FrameGeometry::kGridCols || c1 < 0 || r0 >= FrameGeometry::kGridRows || r1 < 0) return out;
+  if (c0 >= FrameGeometry::kGridCols || c1 < 0 || r0 >= FrameGeometry::kGridRows || r1 < 0) return;
   const bool check_levels = min_level > 0 || max_level >= 0;
   for (int gy = r0; gy <= r1; ++gy) {
     for (int gx = c0; gx <= c1; ++gx) {
@@ -122,7 +129,6 @@ std::vector<size_t> Frame::featuresInArea(double x, double y, double r, int min_
       }
     }
   }
-  return out;
 }
 
 bool Frame::unprojectWorld(size_t i, Eigen::Vector3d& Xw) const {

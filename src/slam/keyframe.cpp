@@ -26,7 +26,7 @@ int KeyFrame::trackedMapPoints(int min_obs) const {
       ++n;
       continue;
     }
-    if (p->weightedObservations() >= min_obs) ++n;
+    if (p->weightedObservationsAtLeast(min_obs)) ++n;
   }
   return n;
 }

@@ -238,7 +238,8 @@ void LocalMapping::mapPointCulling() {
     } else if (mp->foundRatio() < kMinFoundRatio) {
       map_.eraseMapPoint(mp);
       it = recent_points_.erase(it);
-    } else if (cur - mp->first_kf_id >= kCullAfterKeyFrames && mp->weightedObservations() <= kCullMaxObservations) {
+    } else if (cur - mp->first_kf_id >= kCullAfterKeyFrames &&
+               !mp->weightedObservationsAtLeast(kCullMaxObservations + 1)) {
       map_.eraseMapPoint(mp);
       it = recent_points_.erase(it);
     } else if (cur - mp->first_kf_id >= kKeepAfterKeyFrames) {
@@ -420,7 +421,7 @@ void LocalMapping::keyFrameCulling() {
       // RGB-D: only close points count (far ones are not reliable to judge redundancy).
       if (kf->f.depth[i] > close || kf->f.depth[i] < 0) continue;
       ++n_points;
-      if (mp->weightedObservations() <= th_obs) continue;
+      if (!mp->weightedObservationsAtLeast(th_obs + 1)) continue;
       const int level = kf->f.kps[i].octave;
       int n = 0;
       for (const auto& o : mp->observations) {

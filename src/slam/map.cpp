@@ -43,7 +43,7 @@ void Map::eraseObservation(const MapPointPtr& mp, const KeyFramePtr& kf) {
   if (mp->ref_kf == kf.get())
     mp->ref_kf = mp->observations.empty() ? nullptr : mp->observations.begin()->first.get();
   // ORB-SLAM2: a point seen (with depth) by one keyframe only is dropped.
-  if (mp->weightedObservations() <= 2) eraseMapPoint(mp);
+  if (!mp->weightedObservationsAtLeast(3)) eraseMapPoint(mp);
 }
 
 void Map::eraseMapPoint(const MapPointPtr& mp) {

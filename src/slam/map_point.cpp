@@ -20,10 +20,12 @@ bool MapPoint::inKeyFrame(const KeyFrame* kf) const {
   return false;
 }
 
-int MapPoint::weightedObservations() const {
-  int n = 0;
-  for (const auto& o : observations) n += o.first->f.right_u[o.second] >= 0 ? 2 : 1;
-  return n;
+bool MapPoint::weightedObservationsAtLeast(int n) const {
+  if (n <= 0) return true;
+  int w = 0;
+  for (const auto& o : observations)
+    if ((w += o.first->f.right_u[o.second] >= 0 ? 2 : 1) >= n) return true;
+  return false;
 }
 
 MapPointPtr MapPoint::resolve(MapPointPtr p) {

@@ -62,7 +62,7 @@ bool projectInFrame(const Frame& F, const MapPointPtr& mp, double min_view_cos, 
 int searchLastFrame(Frame& F, const Frame& last, double th) {
   int n = 0;
   features::RotationHistogram hist;
-  std::vector<size_t> matched_idx;
+  std::vector<size_t> cand;
   const Pose T_lc = last.T_cw * F.T_cw.inverse();
   const double tz = T_lc.inverse().translation().z();  // ORB-SLAM2 tlc(2)
   const double b = F.cam.baseline();
@@ -77,10 +77,9 @@ int searchLastFrame(Frame& F, const Frame& last, double th) {
     if (F.geom.outside(uv)) continue;
     const int oct = last.kps[i].octave;
     const double radius = th * pyr.scale[oct];
-    std::vector<size_t> cand;
-    if (forward) cand = F.featuresInArea(uv.x(), uv.y(), radius, oct);
-    else if (backward) cand = F.featuresInArea(uv.x(), uv.y(), radius, 0, oct);
-    else cand = F.featuresInArea(uv.x(), uv.y(), radius, oct - 1, oct + 1);
+    if (forward) F.featuresInArea(cand, uv.x(), uv.y(), radius, oct);
+    else if (backward) F.featuresInArea(cand, uv.x(), uv.y(), radius, 0, oct);
+    else F.featuresInArea(cand, uv.x(), uv.y(), radius, oct - 1, oct + 1);
     if (cand.empty() || mp->descriptor.empty()) continue;
     const double ur = uv.x() - F.cam.bf / pc.z();
     int best = kNoMatch;
@@ -117,9 +116,12 @@ struct DynamicCandidates {
   int unmoved = kNoMatch, unmoved2 = kNoMatch, unmoved_idx = -1;
 };
 
-DynamicCandidates dynamicCandidates(const Frame& F, const Projection& p, double r) {
+// `cand` is the caller's buffer, reused across calls.
+DynamicCandidates dynamicCandidates(const Frame& F, const Projection& p, double r,
+                                    std::vector<size_t>& cand) {
   DynamicCandidates c;
-  for (size_t j : F.featuresInArea(p.u, p.v, r, p.level - 1, p.level, true)) {
+  F.featuresInArea(cand, p.u, p.v, r, p.level - 1, p.level, true);
+  for (size_t j : cand) {
     if (p.z > 0 && F.depth[j] > 0 && std::fabs(F.depth[j] - p.z) > kDynamicDepthTolerance * p.z) continue;
     const int d = dist(p.mp->descriptor, F.descriptors, static_cast<int>(j));
     // When the frame-to-frame test ran, only a keypoint it saw move counts as a hit: static
@@ -148,11 +150,12 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
   int n = 0;
   const auto& pyr = *F.pyramid;
   const bool match_dropped = dropped && dropped->min_observations > 0 && !F.motion.empty();
+  std::vector<size_t> cand, dynamic_cand;
   for (const Projection& p : proj) {
     const MapPointPtr& mp = p.mp;
     if (!mp || mp->bad || mp->descriptor.empty()) continue;
     const double r = (p.view_cos > kFrontalViewCos ? kFrontalWindow : kObliqueWindow) * th * pyr.scale[p.level];
-    std::vector<size_t> cand = F.featuresInArea(p.u, p.v, r, p.level - 1, p.level);
+    F.featuresInArea(cand, p.u, p.v, r, p.level - 1, p.level);
     int best = kNoMatch, best2 = kNoMatch, best_level = -1, best_level2 = -1, best_idx = -1;
     for (size_t j : cand) {
       const MapPointPtr& cur = F.points[j];
@@ -171,7 +174,7 @@ int searchProjections(Frame& F, const std::vector<Projection>& proj, double th, 
       }
     }
     DynamicCandidates dyn;
-    if (dynamic_hits || match_dropped) dyn = dynamicCandidates(F, p, r);
+    if (dynamic_hits || match_dropped) dyn = dynamicCandidates(F, p, r, dynamic_cand);
     // A point that now projects onto a moving keypoint with a better descriptor match than any
     // static one sits on a moving object, if that keypoint is at the point's depth (a nearer
     // one is a person walking in front of the point: hidden, not moving).

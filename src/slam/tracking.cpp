@@ -107,6 +107,34 @@ void clearAssociations(Frame& F) {
   std::fill(F.outlier.begin(), F.outlier.end(), false);
 }
 
+// The keyframes observing the frame's points, by id, each marked with the frame (KeyFrame::
+// local_ref_frame) and counting the points it shares with it (local_count).
+std::vector<const KeyFramePtr*> observingKeyFrames(const Frame& F) {
+  std::vector<const KeyFramePtr*> seen;
+  for (const auto& mp : F.points) {
+    if (!mp) continue;
+    for (const auto& o : mp->observations) {
+      KeyFrame& kf = *o.first;
+      if (kf.local_ref_frame != F.id) {
+        kf.local_ref_frame = F.id;
+        kf.local_count = 0;
+        seen.push_back(&o.first);
+      }
+      ++kf.local_count;
+    }
+  }
+  std::sort(seen.begin(), seen.end(),
+            [](const KeyFramePtr* a, const KeyFramePtr* b) { return (*a)->id < (*b)->id; });
+  return seen;
+}
+
+// Takes kf into the frame's local map unless it is bad or already in (marked with the frame).
+bool takeIntoLocalMap(KeyFrame& kf, long frame_id) {
+  if (kf.bad || kf.local_ref_frame == frame_id) return false;
+  kf.local_ref_frame = frame_id;
+  return true;
+}
+
 }  // namespace
 
 Tracking::Tracking(const CameraModel& cam, const TrackingOptions& opt, Map& map, LocalMapping* mapper,
@@ -596,42 +624,36 @@ void Tracking::updateLocalMap(Frame& F) {
   // Local keyframes: those sharing points with the frame, plus their best covisibles,
   // a child and the parent (ORB-SLAM2 UpdateLocalKeyFrames).
   dropBadPoints(F);
-  std::map<KeyFramePtr, int, ById> counter;
-  for (const auto& mp : F.points)
-    if (mp)
-      for (const auto& o : mp->observations) counter[o.first]++;
+  const std::vector<const KeyFramePtr*> observing = observingKeyFrames(F);
   // Without associations (startFromPrediction) the last frame's local map stays.
-  if (counter.empty()) return;
+  if (observing.empty()) return;
   local_kfs_.clear();
-  std::set<long> in_local;
   int max_count = 0;
   KeyFramePtr best;
-  for (const auto& c : counter) {
-    if (c.first->bad) continue;
-    if (c.second > max_count) {
-      max_count = c.second;
-      best = c.first;
+  for (const KeyFramePtr* kf : observing) {
+    if ((*kf)->bad) continue;
+    if ((*kf)->local_count > max_count) {
+      max_count = (*kf)->local_count;
+      best = *kf;
     }
-    local_kfs_.push_back(c.first);
-    in_local.insert(c.first->id);
+    local_kfs_.push_back(*kf);
   }
   const size_t n_direct = local_kfs_.size();
   for (size_t k = 0; k < n_direct && local_kfs_.size() < kMaxLocalKeyFrames; ++k) {
     KeyFramePtr kf = local_kfs_[k];
     for (const auto& nb : kf->bestCovisibles(kLocalCovisibles)) {
-      if (!nb->bad && in_local.insert(nb->id).second) {
+      if (takeIntoLocalMap(*nb, F.id)) {
         local_kfs_.push_back(nb);
         break;
       }
     }
     for (KeyFrame* child : kf->children) {
-      if (!child->bad && in_local.insert(child->id).second) {
+      if (takeIntoLocalMap(*child, F.id)) {
         local_kfs_.push_back(child->self());
         break;
       }
     }
-    if (kf->parent && !kf->parent->bad && in_local.insert(kf->parent->id).second)
-      local_kfs_.push_back(kf->parent);
+    if (kf->parent && takeIntoLocalMap(*kf->parent, F.id)) local_kfs_.push_back(kf->parent);
   }
   if (best) ref_kf_ = best;
 

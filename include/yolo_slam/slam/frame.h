@@ -85,6 +85,9 @@ class Frame {
   // (max_level < 0: no upper bound). Static keypoints only, or dynamic ones only.
   std::vector<size_t> featuresInArea(double x, double y, double r, int min_level = -1,
                                      int max_level = -1, bool dynamic_only = false) const;
+  // The same into `out` (cleared first): the matchers' loops reuse one buffer.
+  void featuresInArea(std::vector<size_t>& out, double x, double y, double r, int min_level = -1,
+                      int max_level = -1, bool dynamic_only = false) const;
   // World point of keypoint i from its depth (requires a pose and depth > 0).
   bool unprojectWorld(size_t i, Eigen::Vector3d& Xw) const;
   // Number of keypoints (static) with valid depth.

@@ -35,13 +35,17 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   bool not_erase = false;                          // protected from culling (loop closing)
   bool is_origin = false;                          // first keyframe of the map: never erased
   Pose T_cp = Pose::Identity();                    // pose relative to parent, kept when erased
+  // Tracking scratch (per frame, as MapPoint::local_ref_frame): the frame whose local map last
+  // took this keyframe in, and how many of that frame's points it observes.
+  long local_ref_frame = -1;
+  int local_count = 0;
 
   const Pose& Tcw() const { return f.T_cw; }
   Pose Twc() const { return f.T_cw.inverse(); }
   Eigen::Vector3d center() const { return f.T_cw.inverse().translation(); }
 
   std::vector<MapPointPtr> mapPoints() const;      // live, non-null
-  // Points with >= min_obs observations, counted as MapPoint::weightedObservations.
+  // Points with >= min_obs observations, counted as MapPoint::weightedObservationsAtLeast.
   int trackedMapPoints(int min_obs) const;
 
   // Rebuilds this keyframe's covisibility edges from its points (both directions) and, on the

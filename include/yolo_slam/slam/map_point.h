@@ -37,9 +37,9 @@ class MapPoint {
 
   bool inKeyFrame(const KeyFrame* kf) const;
   int numObservations() const { return static_cast<int>(observations.size()); }
-  // Observations, those with depth (a virtual right coordinate) counted twice (ORB-SLAM2
-  // MapPoint::nObs for stereo/RGB-D).
-  int weightedObservations() const;
+  // Whether the observations, those with depth (a virtual right coordinate) counted twice
+  // (ORB-SLAM2 MapPoint::nObs for stereo/RGB-D), reach n; stops counting there.
+  bool weightedObservationsAtLeast(int n) const;
   double foundRatio() const { return visible > 0 ? static_cast<double>(found) / visible : 0.0; }
   // Follows the replacement chain; returns the live point (or null if it ended in a bad one).
   static MapPointPtr resolve(MapPointPtr p);
