@@ -41,6 +41,7 @@ const OptionTable<BoxTrackerOptions>& trackerFields() {
       {"Screening.trackMinScore", &O::min_score, Range::closed(0, 1)},
       {"Screening.trackShiftStale", &O::shift_stale},
       {"Screening.trackNearFraction", &O::near_fraction, Range::fraction()},
+      {"Screening.trackNearMaxAge", &O::near_max_age, Range::atLeast(1)},
   };
   return table;
 }
@@ -154,7 +155,10 @@ bool BoxTracker::carry(Track& tr, const features::FeatureFrame& frame, const det
   const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
   const bool near =
       isNearPersonBox(tr.box.rect, frame.width, frame.height, opt_.near_fraction) && tr.best_score >= opt_.min_score;
-  if (++tr.age > opt_.max_age || (detector_ran && !near && tr.box.score < opt_.min_score)) return false;
+  tr.unmatched = tr.moved_now ? 0 : tr.unmatched + 1;
+  const int max_age = near ? std::max(opt_.max_age, opt_.near_max_age) : opt_.max_age;
+  if (++tr.age > max_age || tr.unmatched > opt_.max_age) return false;
+  if (detector_ran && !near && tr.box.score < opt_.min_score) return false;
   if (!tr.moved_now && !near) return false;
   const cv::Point2f d = tr.moved_now.value_or(cv::Point2f(0.f, 0.f));
   cv::Rect2f moved(tr.box.rect.x + d.x, tr.box.rect.y + d.y, tr.box.rect.width, tr.box.rect.height);
@@ -202,6 +206,7 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
       tr.box = out[track_det[t]];
       tr.best_score = std::max(tr.best_score, tr.box.score);
       tr.age = 0;
+      tr.unmatched = 0;
       kept.push_back(std::move(tr));
     } else if (carry(tr, frame, placed, detector_ran)) {
       out.push_back(tr.box);

@@ -299,6 +299,59 @@ TEST(BoxTracker, NearPersonHeldWhileUnmatched) {
   EXPECT_TRUE(tr_small.predict(makeFrame(small, 0, 0, false), {}).empty());
 }
 
+// A person filling the view whom the detector has lost while their keypoints still match: the
+// box follows them for trackNearMaxAge frames; once the matches are gone it is held for
+// trackMaxAge frames more at most, as any near track.
+TEST(BoxTracker, NearPersonFollowedWhileMatched) {
+  const cv::Rect2f near_box(100, 20, 440, 450);
+  const Scene s = makeScene(near_box, 60, 100, 14);
+  BoxTrackerOptions o;
+  o.near_max_age = 12;
+  ASSERT_LT(o.max_age, o.near_max_age);
+  BoxTracker tr(o);
+  startTrack(tr, s, near_box);
+  const float step = 2.f;
+  int k = 1;
+  for (; k <= o.near_max_age; ++k) {
+    features::FeatureFrame f = makeFrame(s, step * k, 0);
+    detection::Boxes b = tr.predict(f, {});
+    ASSERT_EQ(b.size(), 1u) << "frame " << k;
+    EXPECT_TRUE(b[0].tracked);
+    EXPECT_NEAR(b[0].rect.x, near_box.x + step * k, 0.5) << "frame " << k;
+    tr.observe(f);
+  }
+  EXPECT_TRUE(tr.predict(makeFrame(s, step * k, 0), {}).empty());
+
+  // Matched for a few frames, then unmatched: held trackMaxAge frames, then dropped.
+  BoxTracker held(o);
+  startTrack(held, s, near_box);
+  const int matched = 4;
+  for (k = 1; k <= matched; ++k) {
+    features::FeatureFrame f = makeFrame(s, step * k, 0);
+    ASSERT_EQ(held.predict(f, {}).size(), 1u);
+    held.observe(f);
+  }
+  for (int u = 1; u <= o.max_age; ++u) {
+    features::FeatureFrame f = makeFrame(s, 0, 0, false);
+    detection::Boxes b = held.predict(f, {});
+    ASSERT_EQ(b.size(), 1u) << "unmatched frame " << u;
+    EXPECT_NEAR(b[0].rect.x, near_box.x + step * matched, 0.5);
+    held.observe(f);
+  }
+  EXPECT_TRUE(held.predict(makeFrame(s, 0, 0, false), {}).empty());
+
+  // A box that is not near the camera keeps trackMaxAge, matched or not.
+  BoxTracker small(o);
+  const Scene s_small = makeScene(kBox, 40, 100, 15);
+  startTrack(small, s_small, kBox);
+  for (k = 1; k <= o.max_age; ++k) {
+    features::FeatureFrame f = makeFrame(s_small, step * k, 0);
+    ASSERT_EQ(small.predict(f, {}).size(), 1u);
+    small.observe(f);
+  }
+  EXPECT_TRUE(small.predict(makeFrame(s_small, step * k, 0), {}).empty());
+}
+
 TEST(BoxTracker, NearPersonBoxIsLargeAndTall) {
   EXPECT_TRUE(screening::isNearPersonBox(cv::Rect2f(100, 20, 440, 450), 640, 480, 0.4));
   // Wide over a rolled view but short: not a person at the lens.
@@ -363,6 +416,9 @@ TEST(BoxTracker, OptionsValidated) {
   EXPECT_THROW(BoxTracker{o}, Error);
   o = BoxTrackerOptions{};
   o.near_fraction = 1.5;
+  EXPECT_THROW(BoxTracker{o}, Error);
+  o = BoxTrackerOptions{};
+  o.near_max_age = 0;
   EXPECT_THROW(BoxTracker{o}, Error);
   // Every key's value: test/slam/test_options.cpp.
   Config bad = Config::fromString("%YAML:1.0\nScreening.trackMaxAge: 0\n", "bad.yaml");

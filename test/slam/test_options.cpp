@@ -93,6 +93,7 @@ Screening.trackMinMatches: 6
 Screening.trackMinScore: 0.625
 Screening.trackShiftStale: 0
 Screening.trackNearFraction: 0.625
+Screening.trackNearMaxAge: 21
 Screening.staticBoxVeto: 0
 Screening.staticBoxMaxScore: 0.75
 Screening.staticBoxFraction: 0.625
@@ -277,6 +278,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(t.enabled, t.max_age, t.radius_px, t.max_hamming, t.min_matches, t.min_score, t.shift_stale),
             std::make_tuple(false, 4, 35.5, 45, 6, 0.625, false));
   EXPECT_EQ(t.near_fraction, 0.625);
+  EXPECT_EQ(t.near_max_age, 21);
   const screening::TemporalOptions& m = s.temporal;
   EXPECT_EQ(std::tie(m.static_box_veto, m.static_box_max_score, m.static_box_fraction, m.static_box_min_points),
             std::make_tuple(false, 0.75, 0.625, 12));

@@ -64,9 +64,14 @@ struct BoxTrackerOptions {
   // and where it cannot be matched its box stays where it was (within max_age). Nobody leaves a
   // view they fill in a frame or two. 1 turns it off.
   double near_fraction = 0.4;
+  // A near track whose keypoints are still matched lives this many frames without a detection
+  // (unmatched, max_age frames as any track): the detector can lose a person who fills the view
+  // for a second or more (close seed 65: 17 frames), while their keypoints still move with them.
+  int near_max_age = 30;
 
   // Reads Screening.trackBoxes, trackMaxAge (frames), trackRadius (px), trackMaxHamming (bits),
-  // trackMinMatches, trackMinScore, trackShiftStale, trackNearFraction; throws yolo_slam::Error
+  // trackMinMatches, trackMinScore, trackShiftStale, trackNearFraction, trackNearMaxAge (frames);
+  // throws yolo_slam::Error
   // naming the file and key.
   static BoxTrackerOptions load(const Config& cfg);
   // The loader's rules, for options set in code; throws yolo_slam::Error prefixed by `where`.
@@ -108,6 +113,7 @@ class BoxTracker {
     long id = 0;
     detection::Box box;              // box used in the current frame
     int age = 0;                     // frames since the last detection
+    int unmatched = 0;               // of them, the last ones carried without keypoint matches
     float best_score = 0.f;          // the highest score of the track's detections
     std::vector<cv::Point2f> pts;    // remembered dynamic keypoints (image pixels)
     cv::Mat desc;                    // their descriptors, rows match pts
