@@ -150,6 +150,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Screening.trackMinScore",
       "Screening.trackShiftStale",
       "Screening.trackNearFraction",
+      "Screening.trackNearMaxAge",
       "Screening.trackRadius",
       "Screening.varianceThreshold",
       "Screening.variant",
