@@ -194,6 +194,7 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.minFrames",
       "Tracking.motionPrior",
       "Tracking.motionPriorDeg",
+      "Tracking.motionPriorFrames",
       "Tracking.minInliers",
       "Tracking.relocMinInliers",
       "Tracking.motionWindow",

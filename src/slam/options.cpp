@@ -33,6 +33,7 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.voBelowMapPoints", &O::vo_below_map_points, Range::atLeast(0)},
       {"Tracking.motionPrior", &O::motion_prior, Range::closed(0, 1e6)},
       {"Tracking.motionPriorDeg", &O::motion_prior_deg, Range::closed(0.01, 180)},
+      {"Tracking.motionPriorFrames", &O::motion_prior_frames, Range::closed(1, 30)},
       {"Tracking.maxJump", &O::max_jump, Range::closed(0, 1e6)},
       {"Tracking.maxJumpDeg", &O::max_jump_deg, Range::closed(0, 180)},
       {"Tracking.maxJumpInliers", &O::max_jump_inliers, Range::atLeast(0)},

@@ -170,7 +170,7 @@ void Tracking::checkTimestamp(const Frame& F) {
       if (has_velocity_)
         log::warn("frame %.6f: timestamp jump of %.3f s; motion model reset",
                      F.stamp, dt);
-      has_velocity_ = false;
+      forgetMotion();
     }
   }
   if (stamp_ok) {
@@ -199,7 +199,8 @@ bool Tracking::trackFrame(Frame& F) {
   const Pose prediction = predicted ? Pose(velocity_ * last_.T_cw) : Pose::Identity();
   // Right after a relocalisation the velocity measures the relocalised pose's correction, not the
   // camera's motion: a prior would hold on to it.
-  if (predicted && opt_.motion_prior > 0 && !justRelocalized(F)) prior_ = motionPrior(F, prediction);
+  if (predicted && opt_.motion_prior > 0 && !justRelocalized(F))
+    prior_ = motionPrior(F, priorPrediction(prediction));
   if (state_ == TrackingState::Ok && has_last_) {
     if (has_velocity_) ok = trackMotionModel(F);
     if (!ok && ref_kf_ && !ref_kf_->bad)
@@ -243,6 +244,17 @@ optimization::PosePrior Tracking::motionPrior(const Frame& F, const Pose& predic
   return p;
 }
 
+Pose Tracking::priorPrediction(const Pose& prediction) const {
+  if (opt_.motion_prior_frames <= 1) return prediction;
+  const PredictionTolerance tol{opt_.motion_prior, opt_.motion_prior_deg * M_PI / 180.0};
+  return robustPrediction(recent_, opt_.motion_prior_frames, prediction, last_.T_cw, tol);
+}
+
+void Tracking::forgetMotion() {
+  has_velocity_ = false;
+  recent_.clear();
+}
+
 bool Tracking::implausibleJump(const Pose& T_cw, const Pose& prediction) const {
   const double max_jump = localization_only_ ? opt_.max_jump_localization : opt_.max_jump;
   if (max_jump <= 0 || inliers_ >= opt_.max_jump_inliers) return false;
@@ -262,6 +274,8 @@ void Tracking::onTracked(Frame& F, TrackResult& res) {
     velocity_ = F.T_cw * last_.T_cw.inverse();
     has_velocity_ = finitePose(velocity_);
   }
+  if (!has_velocity_) recent_.clear();
+  recent_.push(F.T_cw, static_cast<size_t>(opt_.motion_prior_frames) + 1);
   // Drop associations to temporary visual-odometry points.
   for (int i = 0; i < F.N; ++i) {
     if (F.points[i] && F.points[i]->numObservations() < 1) {
@@ -292,7 +306,7 @@ void Tracking::onFailed(TrackResult& res) {
   // no longer trustworthy).
   if (failures_in_row_ >= 2 || state_ == TrackingState::Lost) {
     state_ = TrackingState::Lost;
-    has_velocity_ = false;
+    forgetMotion();
   }
   if (state_ == TrackingState::Lost && !localization_only_ && (lostLongInSmallMap() || lostYoung()))
     reset_requested_ = true;
@@ -350,7 +364,8 @@ bool Tracking::initialize(Frame& F) {
   init_kf_id_ = kf->id;
   local_kfs_ = {kf};
   local_points_ = kf->mapPoints();
-  has_velocity_ = false;
+  forgetMotion();
+  recent_.push(F.T_cw, static_cast<size_t>(opt_.motion_prior_frames) + 1);
   failures_in_row_ = 0;
   return true;
 }
@@ -558,7 +573,7 @@ bool Tracking::relocalize(Frame& F) {
 void Tracking::acceptRelocalization(const Frame& F, const KeyFramePtr& kf) {
   ref_kf_ = kf;
   last_reloc_frame_id_ = F.id;
-  has_velocity_ = false;
+  forgetMotion();
   ++relocalizations_;
 }
 
@@ -867,7 +882,7 @@ void Tracking::resetKeepTrajectory() {
   init_kf_id_ = -1;
   last_tracked_id_ = -1;
   last_reloc_frame_id_ = -1;  // a relocalisation in the old map says nothing of the new one
-  has_velocity_ = false;
+  forgetMotion();
   failures_in_row_ = 0;
   lost_frames_in_row_ = 0;
   local_kfs_.clear();

@@ -132,6 +132,7 @@ Tracking.voPoints: 80
 Tracking.voBelowMapPoints: 40
 Tracking.motionPrior: 0.03125
 Tracking.motionPriorDeg: 1.5
+Tracking.motionPriorFrames: 6
 Tracking.maxJump: 0.125
 Tracking.maxJumpDeg: 7.5
 Tracking.maxJumpInliers: 90
@@ -307,6 +308,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   EXPECT_EQ(k.max_jump_localization, 0.0625);
+  EXPECT_EQ(k.motion_prior_frames, 6);
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
                      p.thread_nice, p.free_space_ratio),
@@ -366,6 +368,8 @@ TEST(Options, RejectionsNameFileKeyRuleAndValue) {
             "bad.yaml: key 'Tracking.minInliers' must be >= 6 (got 5)");
   EXPECT_EQ(systemRejection("Tracking.refRatio", "1.5"),
             "bad.yaml: key 'Tracking.refRatio' must be in [0, 1] (got 1.5)");
+  EXPECT_EQ(systemRejection("Tracking.motionPriorFrames", "0"),
+            "bad.yaml: key 'Tracking.motionPriorFrames' must be in [1, 30] (got 0)");
   EXPECT_EQ(systemRejection("LocalMapping.queueSize", "0"),
             "bad.yaml: key 'LocalMapping.queueSize' must be >= 1 (got 0)");
   EXPECT_EQ(systemRejection("LocalMapping.threadNice", "20"),

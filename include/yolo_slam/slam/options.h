@@ -61,6 +61,10 @@ struct TrackingOptions {
   // 41"). 0 = off.
   double motion_prior = 0.005;      // Tracking.motionPrior (m)
   double motion_prior_deg = 1.0;    // Tracking.motionPriorDeg
+  // The prior's prediction: the last frame step (ORB-SLAM2's constant-velocity model, which the
+  // motion-model search always uses), or the mean of the last motionPriorFrames steps when the
+  // two predictions lie more than 3 sigmas apart (slam/motion_model.h); 1 = the last step always.
+  int motion_prior_frames = 4;      // Tracking.motionPriorFrames
   // maxJump > 0: a pose that lands more than maxJump metres (or maxJumpDeg degrees) from the
   // constant-velocity prediction on fewer than maxJumpInliers inliers is refused (the frame
   // fails), for a robot that would rather be lost than jump. Off by default: with the motion

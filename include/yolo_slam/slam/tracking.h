@@ -6,6 +6,7 @@
 #include "yolo_slam/features/feature_frame.h"
 #include "yolo_slam/optimization/pose_optimizer.h"
 #include "yolo_slam/slam/frame.h"
+#include "yolo_slam/slam/motion_model.h"
 #include "yolo_slam/slam/options.h"
 #include "yolo_slam/slam/track_result.h"
 #include "yolo_slam/slam/types.h"
@@ -158,6 +159,9 @@ class Tracking {
   // A map point from keypoint i of F (with depth), observed by kf; caller holds the map mutex.
   // Returns false when the keypoint cannot be back-projected.
   bool createDepthPoint(const KeyFramePtr& kf, Frame& F, int i);
+  // No velocity: the constant-velocity model starts again from the next tracked frames.
+  void forgetMotion();
+  Pose priorPrediction(const Pose& prediction) const;
   bool needNewKeyFrame(const Frame& F) const;
   void createNewKeyFrame(Frame& F);
   void record(const Frame& F);
@@ -183,6 +187,7 @@ class Tracking {
   KeyFramePtr last_ref_;
   bool has_velocity_ = false;
   Pose velocity_ = Pose::Identity();  // T_cl: current from last
+  MotionHistory recent_;              // consecutive tracked frames, for the prior's prediction
   int inliers_ = 0;
   int failures_in_row_ = 0;
   int lost_frames_in_row_ = 0;
