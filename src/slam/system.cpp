@@ -495,13 +495,14 @@ SystemStats System::stats() const {
   LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
   size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0, dropped_matched = 0,
-         vo_frames = 0;
+         vo_frames = 0, prior_mean_step = 0;
   {
     std::lock_guard<std::mutex> tl(track_mutex_);
     relocs = tracker_->relocalizations();
     jumps = tracker_->jumpsRefused();
     from_prediction = tracker_->trackedFromPrediction();
     young_dropped = tracker_->youngPointsDropped();
+    prior_mean_step = tracker_->priorFromMeanStep();
     boxed_withheld = tracker_->boxedPointsWithheld();
     dropped_matched = tracker_->droppedMatched();
     vo_frames = tracker_->voFrames();
@@ -523,6 +524,7 @@ SystemStats System::stats() const {
   s.jumps_refused = jumps;
   s.tracked_from_prediction = from_prediction;
   s.young_points_dropped = young_dropped;
+  s.prior_from_mean_step = prior_mean_step;
   s.boxed_points_withheld = boxed_withheld;
   s.dropped_map_matches = dropped_matched;
   s.vo_frames = vo_frames;
@@ -562,6 +564,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"jumps_refused", s.jumps_refused},
               {"tracked_from_prediction", s.tracked_from_prediction},
               {"young_points_dropped", s.young_points_dropped},
+              {"prior_from_mean_step", s.prior_from_mean_step},
               {"boxed_points_withheld", s.boxed_points_withheld},
               {"dropped_map_matches", s.dropped_map_matches},
               {"vo_frames", s.vo_frames},

@@ -244,10 +244,12 @@ optimization::PosePrior Tracking::motionPrior(const Frame& F, const Pose& predic
   return p;
 }
 
-Pose Tracking::priorPrediction(const Pose& prediction) const {
+Pose Tracking::priorPrediction(const Pose& prediction) {
   if (opt_.motion_prior_frames <= 1) return prediction;
   const PredictionTolerance tol{opt_.motion_prior, opt_.motion_prior_deg * M_PI / 180.0};
-  return robustPrediction(recent_, opt_.motion_prior_frames, prediction, last_.T_cw, tol);
+  const Pose p = robustPrediction(recent_, opt_.motion_prior_frames, prediction, last_.T_cw, tol);
+  if (p.matrix() != prediction.matrix()) ++prior_mean_step_;
+  return p;
 }
 
 void Tracking::forgetMotion() {

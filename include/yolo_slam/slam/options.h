@@ -64,7 +64,9 @@ struct TrackingOptions {
   // The prior's prediction: the last frame step (ORB-SLAM2's constant-velocity model, which the
   // motion-model search always uses), or the mean of the last motionPriorFrames steps when the
   // two predictions lie more than 3 sigmas apart (slam/motion_model.h); 1 = the last step always.
-  int motion_prior_frames = 4;      // Tracking.motionPriorFrames
+  // Off by default: 4 helps held-out crowds and people at the lens but broke the young-point
+  // check's hold on an unscreened walker (BENCHMARKS.md, "Session 43").
+  int motion_prior_frames = 1;      // Tracking.motionPriorFrames
   // maxJump > 0: a pose that lands more than maxJump metres (or maxJumpDeg degrees) from the
   // constant-velocity prediction on fewer than maxJumpInliers inliers is refused (the frame
   // fails), for a robot that would rather be lost than jump. Off by default: with the motion

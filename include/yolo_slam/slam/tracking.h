@@ -74,6 +74,8 @@ class Tracking {
   size_t trackedFromPrediction() const { return from_prediction_; }
   // Matches of once-seen map points released by Tracking.youngPointCheck.
   size_t youngPointsDropped() const { return young_dropped_; }
+  // Frames whose motion prior sat at the mean step's prediction (Tracking.motionPriorFrames).
+  size_t priorFromMeanStep() const { return prior_mean_step_; }
   size_t boxedPointsWithheld() const { return boxed_withheld_; }
   // Dropped keypoints matched to map points and kept by the pose (Tracking.droppedMapMatches):
   // in all, and those of the last frame (indices into its keypoints).
@@ -161,7 +163,7 @@ class Tracking {
   bool createDepthPoint(const KeyFramePtr& kf, Frame& F, int i);
   // No velocity: the constant-velocity model starts again from the next tracked frames.
   void forgetMotion();
-  Pose priorPrediction(const Pose& prediction) const;
+  Pose priorPrediction(const Pose& prediction);
   bool needNewKeyFrame(const Frame& F) const;
   void createNewKeyFrame(Frame& F);
   void record(const Frame& F);
@@ -212,6 +214,7 @@ class Tracking {
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
+  size_t prior_mean_step_ = 0;  // frames whose prior the mean step placed
   size_t boxed_withheld_ = 0;  // keyframe points withheld by Tracking.boxedPointsStaticOnly / movedPointsWithheld
   std::vector<int> dropped_matched_;   // this frame's dropped keypoints matched to map points
   size_t dropped_matched_total_ = 0;
