@@ -24,6 +24,19 @@ double centreDistance(const Pose& a_cw, const Pose& b_cw) {
 
 // A camera moving 1 cm and turning 0.5 degrees per frame.
 const Pose kStep = makePose(Eigen::Vector3d(0.002, 0.008, -0.001), Eigen::Vector3d(0.01, -0.002, 0.003));
+constexpr size_t kCapacity = 5;
+
+// Four poses of a camera moving at kStep; the newest in `newest`.
+slam::MotionHistory steadyHistory(Pose& newest) {
+  slam::MotionHistory h;
+  newest = Pose::Identity();
+  h.push(newest, kCapacity);
+  for (int i = 0; i < 3; ++i) {
+    newest = kStep * newest;
+    h.push(newest, kCapacity);
+  }
+  return h;
+}
 
 }  // namespace
 
@@ -41,14 +54,14 @@ TEST(MotionModel, FractionalStepRepeatedGivesTheWholeMotion) {
 TEST(MotionModel, NeedsTwoPosesAndKeepsItsCapacity) {
   slam::MotionHistory h;
   EXPECT_FALSE(h.meanStep(4).has_value());
-  h.push(Pose::Identity(), 5);
+  h.push(Pose::Identity(), kCapacity);
   EXPECT_FALSE(h.meanStep(4).has_value());
   Pose T = Pose::Identity();
   for (int i = 0; i < 9; ++i) {
     T = kStep * T;
-    h.push(T, 5);
+    h.push(T, kCapacity);
   }
-  EXPECT_EQ(h.size(), 5u);
+  EXPECT_EQ(h.size(), kCapacity);
   // Constant velocity: the mean of any number of steps is the step.
   for (int steps = 1; steps <= 6; ++steps) {
     const auto s = h.meanStep(steps);
@@ -61,17 +74,12 @@ TEST(MotionModel, NeedsTwoPosesAndKeepsItsCapacity) {
 
 TEST(MotionModel, OneDraggedFrameMovesTheMeanPredictionByAFraction) {
   // Four good frames, then one a person dragged 3 cm along the optical axis.
-  slam::MotionHistory h;
-  Pose T = Pose::Identity();
-  h.push(T, 5);
-  for (int i = 0; i < 3; ++i) {
-    T = kStep * T;
-    h.push(T, 5);
-  }
+  Pose T;
+  slam::MotionHistory h = steadyHistory(T);
   const Pose truth_next = kStep * kStep * T;
   Pose dragged = kStep * T;
   dragged.translation().z() += 0.03;
-  h.push(dragged, 5);
+  h.push(dragged, kCapacity);
   const Pose last_only = *h.meanStep(1) * dragged;
   const Pose mean_of_four = *h.meanStep(4) * dragged;
   // The dragged frame itself is 3 cm off; the last step alone predicts the next frame 6 cm off,
@@ -85,17 +93,12 @@ TEST(MotionModel, OneDraggedFrameMovesTheMeanPredictionByAFraction) {
 TEST(MotionModel, TheLastStepStandsUnlessItIsAnOutlier) {
   const slam::PredictionTolerance tol{0.005, 1.0 * M_PI / 180.0};
   const auto run = [&](double drag_m) {
-    slam::MotionHistory h;
-    Pose T = Pose::Identity();
-    h.push(T, 5);
-    for (int i = 0; i < 3; ++i) {
-      T = kStep * T;
-      h.push(T, 5);
-    }
+    Pose T;
+    slam::MotionHistory h = steadyHistory(T);
     const Pose previous = T;
     T = kStep * T;
     T.translation().z() += drag_m;
-    h.push(T, 5);
+    h.push(T, kCapacity);
     const Pose last_step = T * previous.inverse() * T;
     return std::make_pair(slam::robustPrediction(h, 4, last_step, T, tol), last_step);
   };
