@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <future>
@@ -402,6 +403,39 @@ void OrbExtractor::extractLevel(const cv::Mat& img, int level, LevelFeatures& ou
   }
 }
 
+// Level 0 needs no pyramid and holds about a third of the pixels: a helper thread starts on it
+// while this thread builds the pyramid; then both take the remaining levels, largest first,
+// from one counter, so that neither waits for the other's share (levels 1-7 hold about two
+// thirds of the work). Each level writes only its own slot: the result does not depend on
+// which thread did what. An own thread rather than cv::parallel_for_, whose pool size is
+// process-wide and set to one by the asynchronous detector.
+void OrbExtractor::extractOnTwoThreads(const cv::Mat& gray, std::vector<LevelFeatures>& levels) const {
+  const int n_levels = static_cast<int>(levels.size());
+  std::vector<cv::Mat> pyramid;
+  std::promise<void> pyramid_built;
+  std::shared_future<void> pyramid_ready = pyramid_built.get_future().share();
+  std::atomic<int> next_level{1};
+  auto drain = [&] {
+    for (int level = next_level++; level < n_levels; level = next_level++)
+      extractLevel(pyramid[level], level, levels[level]);
+  };
+  std::future<void> helper = std::async(std::launch::async, [&] {
+    extractLevel(gray, 0, levels[0]);
+    pyramid_ready.get();  // rethrows when the pyramid could not be built
+    drain();
+  });
+  try {
+    pyramid = buildPyramid(gray);
+  } catch (...) {
+    pyramid_built.set_exception(std::current_exception());
+    helper.wait();
+    throw;
+  }
+  pyramid_built.set_value();
+  drain();
+  helper.get();
+}
+
 void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints,
                            cv::Mat& descriptors) const {
   if (gray.empty() || gray.type() != CV_8UC1) {
@@ -409,22 +443,14 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
                 std::string(gray.empty() ? "an empty image" : "type " + cv::typeToString(gray.type())) +
                 "; convert to grayscale first (features::buildFeatureFrame does)");
   }
-  const int n_levels = options_.n_levels;
-  std::vector<LevelFeatures> levels(n_levels);
-
-  // Level 0 needs no pyramid, and holds about as much work as all the others together (half
-  // the pixels): with two threads it runs beside the pyramid and the smaller levels. An own
-  // thread rather than cv::parallel_for_, whose pool size is process-wide and set to one by the
-  // asynchronous detector.
-  std::future<void> level0;
+  std::vector<LevelFeatures> levels(options_.n_levels);
   if (options_.threads > 1) {
-    level0 = std::async(std::launch::async, [&] { extractLevel(gray, 0, levels[0]); });
+    extractOnTwoThreads(gray, levels);
   } else {
-    extractLevel(gray, 0, levels[0]);
+    const std::vector<cv::Mat> pyramid = buildPyramid(gray);
+    for (int level = 0; level < options_.n_levels; ++level)
+      extractLevel(pyramid[level], level, levels[level]);
   }
-  const std::vector<cv::Mat> pyramid = buildPyramid(gray);
-  for (int level = 1; level < n_levels; ++level) extractLevel(pyramid[level], level, levels[level]);
-  if (level0.valid()) level0.get();
 
   size_t total = 0;
   for (const LevelFeatures& l : levels) total += l.keypoints.size();

@@ -29,9 +29,9 @@ struct OrbOptions {
   // static points to initialise and track; 3 lets a frame two thirds people keep nFeatures
   // (BENCHMARKS.md, "Session 37").
   double dynamic_boost_max = 3.0;
-  // ORBextractor.threads: 2 extracts pyramid level 0 on a second thread beside the other
-  // levels (the same keypoints and descriptors as 1, in about 60 % of the time when a core is
-  // free); 1 extracts on the caller's thread only.
+  // ORBextractor.threads: 2 extracts the pyramid levels on the caller's and a second thread
+  // (level 0 beside the pyramid's construction, then the others shared; the same keypoints and
+  // descriptors as 1); 1 extracts on the caller's thread only.
   static constexpr int kMaxThreads = 2;
   int threads = 2;
 
@@ -85,6 +85,8 @@ class OrbExtractor {
   std::vector<cv::KeyPoint> fastCorners(const cv::Mat& area) const;
   // Keypoints and descriptors of one pyramid level (img empty: none).
   void extractLevel(const cv::Mat& img, int level, LevelFeatures& out) const;
+  // Every level into `levels` (one slot per level) on this thread and one helper.
+  void extractOnTwoThreads(const cv::Mat& gray, std::vector<LevelFeatures>& levels) const;
 
   OrbOptions options_;
   std::vector<double> scale_factors_, inv_scale_factors_, level_sigma2_, inv_level_sigma2_;
