@@ -40,9 +40,9 @@ Pose robustPrediction(const MotionHistory& history, int steps, const Pose& last_
   const std::optional<Pose> step = history.meanStep(steps);
   if (!step || !step->matrix().allFinite()) return last_step_prediction;
   const Pose mean = *step * last_T_cw;
-  const double moved = (mean.inverse().translation() - last_step_prediction.inverse().translation()).norm();
-  const double turned = Eigen::AngleAxisd((mean * last_step_prediction.inverse()).linear()).angle();
-  const bool outlier = moved > kStepOutlierSigmas * tol.sigma_m || turned > kStepOutlierSigmas * tol.sigma_rad;
+  const PoseGap gap = poseGap(mean, last_step_prediction);
+  const bool outlier = gap.moved_m > kStepOutlierSigmas * tol.sigma_m ||
+                       gap.turned_rad > kStepOutlierSigmas * tol.sigma_rad;
   return outlier ? mean : last_step_prediction;
 }
 

@@ -260,10 +260,8 @@ void Tracking::forgetMotion() {
 bool Tracking::implausibleJump(const Pose& T_cw, const Pose& prediction) const {
   const double max_jump = localization_only_ ? opt_.max_jump_localization : opt_.max_jump;
   if (max_jump <= 0 || inliers_ >= opt_.max_jump_inliers) return false;
-  const Pose delta = T_cw * prediction.inverse();
-  const double moved = (T_cw.inverse().translation() - prediction.inverse().translation()).norm();
-  const double turned_deg = Eigen::AngleAxisd(delta.rotation()).angle() * 180.0 / M_PI;
-  return moved > max_jump || turned_deg > opt_.max_jump_deg;
+  const PoseGap gap = poseGap(T_cw, prediction);
+  return gap.moved_m > max_jump || gap.turned_rad * 180.0 / M_PI > opt_.max_jump_deg;
 }
 
 void Tracking::onTracked(Frame& F, TrackResult& res) {

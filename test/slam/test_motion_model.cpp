@@ -18,10 +18,6 @@ Pose makePose(const Eigen::Vector3d& axis_angle, const Eigen::Vector3d& t) {
   return T;
 }
 
-double centreDistance(const Pose& a_cw, const Pose& b_cw) {
-  return (a_cw.inverse().translation() - b_cw.inverse().translation()).norm();
-}
-
 // A camera moving 1 cm and turning 0.5 degrees per frame.
 const Pose kStep = makePose(Eigen::Vector3d(0.002, 0.008, -0.001), Eigen::Vector3d(0.01, -0.002, 0.003));
 constexpr size_t kCapacity = 5;
@@ -84,8 +80,8 @@ TEST(MotionModel, OneDraggedFrameMovesTheMeanPredictionByAFraction) {
   const Pose mean_of_four = *h.meanStep(4) * dragged;
   // The dragged frame itself is 3 cm off; the last step alone predicts the next frame 6 cm off,
   // the mean of four about 3.75.
-  const double off_last = centreDistance(last_only, truth_next);
-  const double off_mean = centreDistance(mean_of_four, truth_next);
+  const double off_last = poseGap(last_only, truth_next).moved_m;
+  const double off_mean = poseGap(mean_of_four, truth_next).moved_m;
   EXPECT_NEAR(off_last, 0.06, 0.005);
   EXPECT_NEAR(off_mean, 0.0375, 0.005);
 }
@@ -110,5 +106,21 @@ TEST(MotionModel, TheLastStepStandsUnlessItIsAnOutlier) {
   }
   // A step 3 cm off: the mean's.
   const auto [p, last_step] = run(0.03);
-  EXPECT_GT(centreDistance(p, last_step), 0.02);
+  EXPECT_GT(poseGap(p, last_step).moved_m, 0.02);
+}
+
+// Camera centres 0.3 m apart and a 20 degree turn between the two orientations, whatever the
+// poses' common world offset.
+TEST(MotionModel, PoseGapIsTheCentreDistanceAndTheTurn) {
+  const Pose world = makePose(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
+                              Eigen::Vector3d(4, -1, 2));
+  Pose a_wc = Pose::Identity(), b_wc = Pose::Identity();
+  b_wc.linear() = Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  b_wc.translation() = Eigen::Vector3d(0.0, 0.3, 0.0);
+  const PoseGap gap = poseGap((world * a_wc).inverse(), (world * b_wc).inverse());
+  EXPECT_NEAR(gap.moved_m, 0.3, 1e-12);
+  EXPECT_NEAR(gap.turned_rad * 180.0 / M_PI, 20.0, 1e-9);
+  const PoseGap none = poseGap(world, world);
+  EXPECT_NEAR(none.moved_m, 0.0, 1e-12);
+  EXPECT_NEAR(none.turned_rad, 0.0, 1e-12);
 }

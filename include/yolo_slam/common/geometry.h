@@ -28,6 +28,17 @@ inline double rotationAngle(const Eigen::Matrix3d& R) {
   return std::acos(c);
 }
 
+// How far apart two camera poses (T_cw) are: the distance between the camera centres (metres)
+// and the angle of the rotation between them (radians).
+struct PoseGap {
+  double moved_m = 0.0;
+  double turned_rad = 0.0;
+};
+inline PoseGap poseGap(const Pose& a_cw, const Pose& b_cw) {
+  return {(a_cw.inverse().translation() - b_cw.inverse().translation()).norm(),
+          Eigen::AngleAxisd((a_cw * b_cw.inverse()).linear()).angle()};
+}
+
 inline Pose makePose(const Eigen::Quaterniond& q, const Eigen::Vector3d& t) {
   Pose T = Pose::Identity();
   T.linear() = q.normalized().toRotationMatrix();
