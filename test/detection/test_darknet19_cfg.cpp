@@ -6,7 +6,7 @@
 #include "yolo_slam/detection/model_files.h"
 
 #include <gtest/gtest.h>
-#include "detection/temp_dir.h"
+#include "support/temp_dir.h"
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgcodecs.hpp>
 

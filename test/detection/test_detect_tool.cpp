@@ -2,7 +2,7 @@
 #include "yolo_slam/common/paths.h"
 
 #include <gtest/gtest.h>
-#include "detection/temp_dir.h"
+#include "support/temp_dir.h"
 
 #include <opencv2/imgcodecs.hpp>
 

@@ -5,7 +5,7 @@
 #include "yolo_slam/detection/model_files.h"
 
 #include <gtest/gtest.h>
-#include "detection/temp_dir.h"
+#include "support/temp_dir.h"
 
 #include <cstdio>
 #include <fstream>

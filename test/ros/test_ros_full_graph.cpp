@@ -4,6 +4,8 @@
 // pose and path published, the tf tree map -> odom -> base_link -> camera complete, no frame
 // dropped, the trajectory saved by the service within an ATE bound. Optionally rviz runs under
 // Xvfb with config/yolo_slam.rviz and a screenshot must show the path and the map points.
+#include "support/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
@@ -134,9 +136,10 @@ TEST(FullGraph, SyntheticWalkingBag) {
   }
   ASSERT_FALSE(script.empty()) << "~tum_to_bag not set";
 
-  char tmpl[] = "/tmp/yolo_slam_full_graph_XXXXXX";
-  ASSERT_NE(mkdtemp(tmpl), nullptr);
-  const std::string dir = tmpl, seq = dir + "/seq", bag = dir + "/seq.bag";
+  // The sequence and its bag take about 170 MB: removed when the test passes.
+  const yolo_slam::test::TempDir tmp("yolo_slam_full_graph", /*keep_on_failure=*/true);
+  ASSERT_TRUE(tmp.ok());
+  const std::string dir = tmp.path(), seq = dir + "/seq", bag = dir + "/seq.bag";
   ASSERT_EQ(run("rosrun yolo_slam yolo_slam_synth --preset " + preset + " --seed 1 --frames " +
                 std::to_string(frames) + " --out " + seq + " > " + dir + "/synth.log 2>&1"), 0);
   ASSERT_EQ(run("/usr/bin/python3 " + script + " --layout " + layout + " " + seq + " " + bag + " > " + dir +

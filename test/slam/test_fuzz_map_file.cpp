@@ -12,7 +12,7 @@
 #include "yolo_slam/slam/map_file.h"
 #include "yolo_slam/slam/system.h"
 
-#include "detection/temp_dir.h"
+#include "support/temp_dir.h"
 #include "support/mutate.h"
 
 #include <gtest/gtest.h>

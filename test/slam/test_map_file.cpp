@@ -15,7 +15,7 @@
 #include "yolo_slam/vocabulary/keyframe_database.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
 
-#include "detection/temp_dir.h"
+#include "support/temp_dir.h"
 #include "support/loop_preset.h"
 
 #include <gtest/gtest.h>

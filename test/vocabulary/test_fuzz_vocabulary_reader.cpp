@@ -6,7 +6,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/vocabulary/trainer.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
-#include "vocabulary/temp_dir.h"
+#include "support/temp_dir.h"
 
 #include "support/mutate.h"
 
@@ -81,7 +81,7 @@ int fuzz(const std::string& valid, const std::string& file, unsigned seed) {
 }  // namespace
 
 TEST(FuzzVocabulary, TextAndBinaryMutantsLoadOrAreRefusedCleanly) {
-  vocab_test::ScopedTempDir dir;
+  test::TempDir dir;
   const auto voc = tinyVocabulary();
   const std::string text = dir.path() + "/v.txt", binary = dir.path() + "/v.vocab";
   voc->saveText(text);

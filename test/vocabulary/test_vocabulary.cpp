@@ -1,7 +1,7 @@
 #include "yolo_slam/common/error.h"
 #include "yolo_slam/vocabulary/trainer.h"
 #include "yolo_slam/vocabulary/vocabulary.h"
-#include "vocabulary/temp_dir.h"
+#include "support/temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 
 using namespace yolo_slam;
 using namespace yolo_slam::vocabulary;
-using yolo_slam::vocab_test::ScopedTempDir;
+using yolo_slam::test::TempDir;
 
 namespace {
 
@@ -78,7 +78,7 @@ std::string handWrittenOrbVoc() {
 }  // namespace
 
 TEST(Vocabulary, SaveLoadRoundTripIsBitIdentical) {
-  ScopedTempDir tmp;
+  TempDir tmp;
   ASSERT_TRUE(tmp.ok());
   auto v = smallVocab();
   ASSERT_GT(v->size(), 16u);
@@ -102,7 +102,7 @@ TEST(Vocabulary, SaveLoadRoundTripIsBitIdentical) {
 }
 
 TEST(Vocabulary, CorruptOrMissingFilesAreErrorsNamingTheFile) {
-  ScopedTempDir tmp;
+  TempDir tmp;
   ASSERT_TRUE(tmp.ok());
   auto v = smallVocab();
   const std::string p = tmp.file("c.vocab");
@@ -147,7 +147,7 @@ TEST(Vocabulary, CorruptOrMissingFilesAreErrorsNamingTheFile) {
 }
 
 TEST(Vocabulary, ReadsHandWrittenOrbVocText) {
-  ScopedTempDir tmp;
+  TempDir tmp;
   ASSERT_TRUE(tmp.ok());
   const std::string p = tmp.file("orbvoc.txt");
   writeBytes(p, handWrittenOrbVoc());
@@ -195,7 +195,7 @@ TEST(Vocabulary, ReadsHandWrittenOrbVocText) {
 }
 
 TEST(Vocabulary, TextReaderErrorsNameFileAndLine) {
-  ScopedTempDir tmp;
+  TempDir tmp;
   ASSERT_TRUE(tmp.ok());
   const std::string p = tmp.file("bad.txt");
   auto expectError = [&](const std::string& text, const std::string& needle) {
