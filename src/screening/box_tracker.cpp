@@ -153,8 +153,9 @@ bool BoxTracker::carry(Track& tr, const features::FeatureFrame& frame, const det
   // A weak track is dropped when the detector looked and did not find it again; a frame the
   // detector never saw (asynchronous detection) carries every track.
   const cv::Rect2f image(0.f, 0.f, static_cast<float>(frame.width), static_cast<float>(frame.height));
-  const bool near =
-      isNearPersonBox(tr.box.rect, frame.width, frame.height, opt_.near_fraction) && tr.best_score >= opt_.min_score;
+  tr.near = tr.near || (isNearPersonBox(tr.box.rect, frame.width, frame.height, opt_.near_fraction) &&
+                         tr.best_score >= opt_.min_score);
+  const bool near = tr.near;
   tr.unmatched = tr.moved_now ? 0 : tr.unmatched + 1;
   const int max_age = near ? std::max(opt_.max_age, opt_.near_max_age) : opt_.max_age;
   if (++tr.age > max_age || tr.unmatched > opt_.max_age) return false;
@@ -205,6 +206,7 @@ detection::Boxes BoxTracker::predict(const features::FeatureFrame& frame,
       det_used[track_det[t]] = true;
       tr.box = out[track_det[t]];
       tr.best_score = std::max(tr.best_score, tr.box.score);
+      tr.near = false;  // judged again from the detection's box when it is next carried
       tr.age = 0;
       tr.unmatched = 0;
       kept.push_back(std::move(tr));

@@ -299,6 +299,29 @@ TEST(BoxTracker, NearPersonHeldWhileUnmatched) {
   EXPECT_TRUE(tr_small.predict(makeFrame(small, 0, 0, false), {}).empty());
 }
 
+// A person filling the view, cut by the top of the image, whose keypoints move up: the carried
+// box is clipped a little more every frame and soon covers less than nine tenths of the
+// image's height, but the track stays a near person's for trackNearMaxAge frames.
+TEST(BoxTracker, NearPersonStaysNearWhileTheBorderClipsTheirBox) {
+  const cv::Rect2f near_box(100, 0, 440, 460);
+  const Scene s = makeScene(near_box, 80, 100, 15);
+  BoxTrackerOptions o;
+  o.near_max_age = 12;
+  ASSERT_LT(o.max_age, o.near_max_age);
+  BoxTracker tr(o);
+  startTrack(tr, s, near_box);
+  const float step = -3.f;
+  for (int k = 1; k <= o.near_max_age; ++k) {
+    features::FeatureFrame f = makeFrame(s, 0, step * k);
+    detection::Boxes b = tr.predict(f, {});
+    ASSERT_EQ(b.size(), 1u) << "frame " << k;
+    EXPECT_TRUE(b[0].tracked);
+    EXPECT_NEAR(b[0].rect.height, near_box.height + step * k, 0.5) << "frame " << k;
+    tr.observe(f);
+  }
+  ASSERT_LT(near_box.height + step * o.near_max_age, 0.9f * 480);  // no longer near by its box
+}
+
 // A person filling the view whom the detector has lost while their keypoints still match: the
 // box follows them for trackNearMaxAge frames; once the matches are gone it is held for
 // trackMaxAge frames more at most, as any near track.

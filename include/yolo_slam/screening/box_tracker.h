@@ -115,6 +115,9 @@ class BoxTracker {
     int age = 0;                     // frames since the last detection
     int unmatched = 0;               // of them, the last ones carried without keypoint matches
     float best_score = 0.f;          // the highest score of the track's detections
+    // A near person's track (isNearPersonBox) stays near while it is carried: its box, moved
+    // and clipped at the image border each frame, shrinks, though the person still fills the view.
+    bool near = false;
     std::vector<cv::Point2f> pts;    // remembered dynamic keypoints (image pixels)
     cv::Mat desc;                    // their descriptors, rows match pts
     std::optional<cv::Point2f> moved_now;  // keypoint displacement into the frame in predict()
