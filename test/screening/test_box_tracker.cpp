@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 using namespace yolo_slam;
@@ -77,6 +78,28 @@ void startTrack(BoxTracker& tr, const Scene& s, const cv::Rect2f& box) {
   features::FeatureFrame f = makeFrame(s, 0, 0);
   tr.predict(f, {personBox(box)});
   tr.observe(f);
+}
+
+// Options whose near tracks outlive trackMaxAge by a margin the tests can see.
+BoxTrackerOptions longNearOptions() {
+  BoxTrackerOptions o;
+  o.near_max_age = 12;
+  EXPECT_LT(o.max_age, o.near_max_age);
+  return o;
+}
+
+// Frames 1..n of `s` with the person moved by `step` a frame and no detection: each has the
+// one carried box, which `check` inspects.
+void expectCarriedNear(BoxTracker& tr, const Scene& s, int n, cv::Point2f step,
+                       const std::function<void(const cv::Rect2f&, int)>& check) {
+  for (int k = 1; k <= n; ++k) {
+    features::FeatureFrame f = makeFrame(s, step.x * k, step.y * k);
+    detection::Boxes b = tr.predict(f, {});
+    ASSERT_EQ(b.size(), 1u) << "frame " << k;
+    EXPECT_TRUE(b[0].tracked);
+    check(b[0].rect, k);
+    tr.observe(f);
+  }
 }
 
 }  // namespace
@@ -299,50 +322,20 @@ TEST(BoxTracker, NearPersonHeldWhileUnmatched) {
   EXPECT_TRUE(tr_small.predict(makeFrame(small, 0, 0, false), {}).empty());
 }
 
-// A person filling the view, cut by the top of the image, whose keypoints move up: the carried
-// box is clipped a little more every frame and soon covers less than nine tenths of the
-// image's height, but the track stays a near person's for trackNearMaxAge frames.
-TEST(BoxTracker, NearPersonStaysNearWhileTheBorderClipsTheirBox) {
-  const cv::Rect2f near_box(100, 0, 440, 460);
-  const Scene s = makeScene(near_box, 80, 100, 15);
-  BoxTrackerOptions o;
-  o.near_max_age = 12;
-  ASSERT_LT(o.max_age, o.near_max_age);
-  BoxTracker tr(o);
-  startTrack(tr, s, near_box);
-  const float step = -3.f;
-  for (int k = 1; k <= o.near_max_age; ++k) {
-    features::FeatureFrame f = makeFrame(s, 0, step * k);
-    detection::Boxes b = tr.predict(f, {});
-    ASSERT_EQ(b.size(), 1u) << "frame " << k;
-    EXPECT_TRUE(b[0].tracked);
-    EXPECT_NEAR(b[0].rect.height, near_box.height + step * k, 0.5) << "frame " << k;
-    tr.observe(f);
-  }
-  ASSERT_LT(near_box.height + step * o.near_max_age, 0.9f * 480);  // no longer near by its box
-}
-
 // A person filling the view whom the detector has lost while their keypoints still match: the
 // box follows them for trackNearMaxAge frames; once the matches are gone it is held for
 // trackMaxAge frames more at most, as any near track.
 TEST(BoxTracker, NearPersonFollowedWhileMatched) {
   const cv::Rect2f near_box(100, 20, 440, 450);
   const Scene s = makeScene(near_box, 60, 100, 14);
-  BoxTrackerOptions o;
-  o.near_max_age = 12;
-  ASSERT_LT(o.max_age, o.near_max_age);
+  const BoxTrackerOptions o = longNearOptions();
   BoxTracker tr(o);
   startTrack(tr, s, near_box);
   const float step = 2.f;
-  int k = 1;
-  for (; k <= o.near_max_age; ++k) {
-    features::FeatureFrame f = makeFrame(s, step * k, 0);
-    detection::Boxes b = tr.predict(f, {});
-    ASSERT_EQ(b.size(), 1u) << "frame " << k;
-    EXPECT_TRUE(b[0].tracked);
-    EXPECT_NEAR(b[0].rect.x, near_box.x + step * k, 0.5) << "frame " << k;
-    tr.observe(f);
-  }
+  expectCarriedNear(tr, s, o.near_max_age, cv::Point2f(step, 0.f), [&](const cv::Rect2f& r, int frame) {
+    EXPECT_NEAR(r.x, near_box.x + step * frame, 0.5) << "frame " << frame;
+  });
+  int k = o.near_max_age + 1;
   EXPECT_TRUE(tr.predict(makeFrame(s, step * k, 0), {}).empty());
 
   // Matched for a few frames, then unmatched: held trackMaxAge frames, then dropped.
@@ -373,6 +366,22 @@ TEST(BoxTracker, NearPersonFollowedWhileMatched) {
     small.observe(f);
   }
   EXPECT_TRUE(small.predict(makeFrame(s_small, step * k, 0), {}).empty());
+}
+
+// A person filling the view, cut by the top of the image, whose keypoints move up: the carried
+// box is clipped a little more every frame and soon covers less than nine tenths of the
+// image's height, but the track stays a near person's for trackNearMaxAge frames.
+TEST(BoxTracker, NearPersonStaysNearWhileTheBorderClipsTheirBox) {
+  const cv::Rect2f near_box(100, 0, 440, 460);
+  const Scene s = makeScene(near_box, 80, 100, 15);
+  const BoxTrackerOptions o = longNearOptions();
+  BoxTracker tr(o);
+  startTrack(tr, s, near_box);
+  const float step = -3.f;
+  expectCarriedNear(tr, s, o.near_max_age, cv::Point2f(0.f, step), [&](const cv::Rect2f& r, int frame) {
+    EXPECT_NEAR(r.height, near_box.height + step * frame, 0.5) << "frame " << frame;
+  });
+  ASSERT_LT(near_box.height + step * o.near_max_age, 0.9f * 480);  // no longer near by its box
 }
 
 TEST(BoxTracker, NearPersonBoxIsLargeAndTall) {
