@@ -76,24 +76,25 @@ void checkPlottable(const Trajectory& gt, const Trajectory& est, const AteResult
     throw Error("ATE plot: a position or the error is not finite or beyond 1e9 m; the trajectories cannot be drawn");
 }
 
-}  // namespace
+// The top view: the two axes with the largest extent of both trajectories, fitted into a panel.
+struct TopView {
+  cv::Rect view;
+  int ax = 0, ay = 1;               // world axes drawn as the panel's x and y
+  double scale = 1;                 // pixels per metre
+  double cxm = 0, cym = 0;          // world coordinates at the panel's centre
+  double step = 1;                  // grid step, metres
 
-cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const AteResult& ate,
-                      const std::string& title) {
-  checkPlottable(gt_in, est_in, ate);
-  const int W = 1000, H = 1120;
-  cv::Mat img(H, W, CV_8UC3, kWhite);
-  const Trajectory gt = uniqueByStamp(gt_in);
-  const Trajectory est = uniqueByStamp(est_in);
+  cv::Point toPx(const Eigen::Vector3d& p) const {
+    return cv::Point(clampedPixel(view.x + view.width / 2 + (p[ax] - cxm) * scale),
+                     clampedPixel(view.y + view.height / 2 - (p[ay] - cym) * scale));
+  }
+};
 
-  std::vector<Eigen::Vector3d> gt_pts, est_pts;
-  for (const auto& p : gt) gt_pts.push_back(p.T_wc.translation());
-  for (const auto& p : est) est_pts.push_back(ate.alignment * p.T_wc.translation());
+// Fraction of the panel the trajectories' extent fills.
+constexpr double kTopViewFill = 0.86;
 
-  text(img, title, {20, 34}, 0.75, kBlack, 2);
-
-  // ---- top view -------------------------------------------------------------------------
-  const cv::Rect view(90, 60, 880, 720);
+TopView fitTopView(const cv::Rect& view, const std::vector<Eigen::Vector3d>& gt_pts,
+                   const std::vector<Eigen::Vector3d>& est_pts) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300);
   for (const auto* set : {&gt_pts, &est_pts}) {
     for (const auto& p : *set) {
@@ -101,119 +102,161 @@ cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const A
       hi = hi.cwiseMax(p);
     }
   }
-  Eigen::Vector3d ext = hi - lo;
+  const Eigen::Vector3d ext = hi - lo;
   // The two axes with the largest extent, kept in x, y, z order (x-y for a usual top view).
   int drop = 0;
   for (int k = 1; k < 3; ++k) {
     if (ext[k] < ext[drop]) drop = k;
   }
-  const int ax = drop == 0 ? 1 : 0, ay = drop == 2 ? 1 : 2;
-  const double ex = std::max(ext[ax], 1e-3), ey = std::max(ext[ay], 1e-3);
-  const double scale = 0.86 * std::min(view.width / ex, view.height / ey);  // pixels per metre
-  const double cxm = 0.5 * (lo[ax] + hi[ax]), cym = 0.5 * (lo[ay] + hi[ay]);
-  auto toPx = [&](const Eigen::Vector3d& p) {
-    return cv::Point(clampedPixel(view.x + view.width / 2 + (p[ax] - cxm) * scale),
-                     clampedPixel(view.y + view.height / 2 - (p[ay] - cym) * scale));
-  };
-  // Metre grid and tick labels.
-  const double span_x = view.width / scale, span_y = view.height / scale;
-  const double step = niceStep(std::max(span_x, span_y), 8);
-  const double x_min = cxm - span_x / 2, y_min = cym - span_y / 2;
-  for (double g = std::ceil(x_min / step) * step; g <= x_min + span_x; g += step) {
-    int u = static_cast<int>(std::lround(view.x + (g - x_min) * scale));
+  TopView tv;
+  tv.view = view;
+  tv.ax = drop == 0 ? 1 : 0;
+  tv.ay = drop == 2 ? 1 : 2;
+  const double ex = std::max(ext[tv.ax], 1e-3), ey = std::max(ext[tv.ay], 1e-3);
+  tv.scale = kTopViewFill * std::min(view.width / ex, view.height / ey);
+  tv.cxm = 0.5 * (lo[tv.ax] + hi[tv.ax]);
+  tv.cym = 0.5 * (lo[tv.ay] + hi[tv.ay]);
+  tv.step = niceStep(std::max(view.width / tv.scale, view.height / tv.scale), 8);
+  return tv;
+}
+
+// Metre grid, tick labels and axis names.
+void drawTopGrid(cv::Mat& img, const TopView& tv) {
+  const cv::Rect& view = tv.view;
+  const double span_x = view.width / tv.scale, span_y = view.height / tv.scale;
+  const double x_min = tv.cxm - span_x / 2, y_min = tv.cym - span_y / 2;
+  for (double g = std::ceil(x_min / tv.step) * tv.step; g <= x_min + span_x; g += tv.step) {
+    int u = static_cast<int>(std::lround(view.x + (g - x_min) * tv.scale));
     cv::line(img, {u, view.y}, {u, view.y + view.height}, kGrid, 1);
-    textCentered(img, fmt(g, step), {u, view.y + view.height + 20}, 0.45, kAxisText);
+    textCentered(img, fmt(g, tv.step), {u, view.y + view.height + 20}, 0.45, kAxisText);
   }
-  for (double g = std::ceil(y_min / step) * step; g <= y_min + span_y; g += step) {
-    int v = static_cast<int>(std::lround(view.y + view.height - (g - y_min) * scale));
+  for (double g = std::ceil(y_min / tv.step) * tv.step; g <= y_min + span_y; g += tv.step) {
+    int v = static_cast<int>(std::lround(view.y + view.height - (g - y_min) * tv.scale));
     cv::line(img, {view.x, v}, {view.x + view.width, v}, kGrid, 1);
-    textRight(img, fmt(g, step), {view.x - 8, v}, 0.45, kAxisText);
+    textRight(img, fmt(g, tv.step), {view.x - 8, v}, 0.45, kAxisText);
   }
   cv::rectangle(img, view, kAxisText, 1);
   const char* names[3] = {"x", "y", "z"};
-  textCentered(img, std::string(names[ax]) + " [m]", {view.x + view.width / 2, view.y + view.height + 44},
-               0.55, kBlack);
-  text(img, std::string(names[ay]) + " [m]", {12, view.y + 14}, 0.55, kBlack);
+  textCentered(img, std::string(names[tv.ax]) + " [m]",
+               {view.x + view.width / 2, view.y + view.height + 44}, 0.55, kBlack);
+  text(img, std::string(names[tv.ay]) + " [m]", {12, view.y + 14}, 0.55, kBlack);
+}
 
-  {
-    // Clip drawing to the panel.
-    cv::Mat roi_img = img.clone();
-    for (size_t k = 0; k < ate.gt_positions.size(); ++k) {
-      cv::line(roi_img, toPx(ate.gt_positions[k]), toPx(ate.est_aligned[k]), kDiff, 1, cv::LINE_AA);
-    }
-    std::vector<cv::Point> g, e;
-    for (const auto& p : gt_pts) g.push_back(toPx(p));
-    for (const auto& p : est_pts) e.push_back(toPx(p));
-    polyline(roi_img, g, kGt, 3);  // under the estimate, wider so it stays visible
-    polyline(roi_img, e, kEst, 1);
-    roi_img(view).copyTo(img(view));
-    cv::rectangle(img, view, kAxisText, 1);
+// The error segments and both trajectories, clipped to the panel.
+void drawTrajectories(cv::Mat& img, const TopView& tv, const AteResult& ate,
+                      const std::vector<Eigen::Vector3d>& gt_pts,
+                      const std::vector<Eigen::Vector3d>& est_pts) {
+  cv::Mat canvas = img.clone();
+  for (size_t k = 0; k < ate.gt_positions.size(); ++k) {
+    cv::line(canvas, tv.toPx(ate.gt_positions[k]), tv.toPx(ate.est_aligned[k]), kDiff, 1, cv::LINE_AA);
   }
+  std::vector<cv::Point> g, e;
+  for (const auto& p : gt_pts) g.push_back(tv.toPx(p));
+  for (const auto& p : est_pts) e.push_back(tv.toPx(p));
+  polyline(canvas, g, kGt, 3);  // under the estimate, wider so it stays visible
+  polyline(canvas, e, kEst, 1);
+  canvas(tv.view).copyTo(img(tv.view));
+  cv::rectangle(img, tv.view, kAxisText, 1);
+}
 
-  // Legend (top left) and scale bar (bottom right).
-  {
-    const cv::Rect box(view.x + 12, view.y + 12, 250, 88);
-    cv::rectangle(img, box, kWhite, cv::FILLED);
-    cv::rectangle(img, box, kAxisText, 1);
-    const std::pair<const char*, cv::Scalar> items[3] = {
-        {"ground truth", kGt}, {"estimate (aligned)", kEst}, {"error (matched pairs)", kDiff}};
-    for (int k = 0; k < 3; ++k) {
-      int y = box.y + 20 + 25 * k;
-      cv::line(img, {box.x + 10, y}, {box.x + 45, y}, items[k].second, k == 0 ? 3 : 2, cv::LINE_AA);
-      text(img, items[k].first, {box.x + 55, y + 5}, 0.5, kBlack);
-    }
-    const int bar = static_cast<int>(std::lround(step * scale));
-    const int bx1 = view.x + view.width - 20, bx0 = bx1 - bar, by = view.y + view.height - 22;
-    cv::rectangle(img, cv::Rect(bx0 - 10, by - 28, bar + 20, 40), kWhite, cv::FILLED);
-    cv::line(img, {bx0, by}, {bx1, by}, kBlack, 3);
-    cv::line(img, {bx0, by - 6}, {bx0, by + 6}, kBlack, 2);
-    cv::line(img, {bx1, by - 6}, {bx1, by + 6}, kBlack, 2);
-    textCentered(img, fmt(step, step) + " m", {(bx0 + bx1) / 2, by - 10}, 0.5, kBlack);
+// Legend (top left) and scale bar (bottom right) of the top view.
+void drawLegend(cv::Mat& img, const TopView& tv) {
+  const cv::Rect& view = tv.view;
+  const cv::Rect box(view.x + 12, view.y + 12, 250, 88);
+  cv::rectangle(img, box, kWhite, cv::FILLED);
+  cv::rectangle(img, box, kAxisText, 1);
+  const std::pair<const char*, cv::Scalar> items[3] = {
+      {"ground truth", kGt}, {"estimate (aligned)", kEst}, {"error (matched pairs)", kDiff}};
+  for (int k = 0; k < 3; ++k) {
+    int y = box.y + 20 + 25 * k;
+    cv::line(img, {box.x + 10, y}, {box.x + 45, y}, items[k].second, k == 0 ? 3 : 2, cv::LINE_AA);
+    text(img, items[k].first, {box.x + 55, y + 5}, 0.5, kBlack);
   }
+  const int bar = static_cast<int>(std::lround(tv.step * tv.scale));
+  const int bx1 = view.x + view.width - 20, bx0 = bx1 - bar, by = view.y + view.height - 22;
+  cv::rectangle(img, cv::Rect(bx0 - 10, by - 28, bar + 20, 40), kWhite, cv::FILLED);
+  cv::line(img, {bx0, by}, {bx1, by}, kBlack, 3);
+  cv::line(img, {bx0, by - 6}, {bx0, by + 6}, kBlack, 2);
+  cv::line(img, {bx1, by - 6}, {bx1, by + 6}, kBlack, 2);
+  textCentered(img, fmt(tv.step, tv.step) + " m", {(bx0 + bx1) / 2, by - 10}, 0.5, kBlack);
+}
 
-  // ---- error over time --------------------------------------------------------------------
-  const cv::Rect panel(90, 870, 880, 190);
-  const double t0 = ate.gt_stamps.empty() ? 0.0 : ate.gt_stamps.front();
-  const double t1 = ate.gt_stamps.empty() ? 1.0 : ate.gt_stamps.back();
-  const double tr = std::max(t1 - t0, 1e-3);
-  const double emax = std::max(ate.stats.max * 1.1, 1e-4);
-  const double tstep = niceStep(tr, 10), estep = niceStep(emax, 4);
-  auto errPx = [&](double t, double e) {
+// The error-over-time panel's axes: time from the first matched pose, error up to its maximum.
+struct ErrorAxes {
+  cv::Rect panel;
+  double t0 = 0, tr = 1, emax = 1;
+
+  cv::Point toPx(double t, double e) const {
     return cv::Point(clampedPixel(panel.x + (t - t0) / tr * panel.width),
                      clampedPixel(panel.y + panel.height - e / emax * panel.height));
-  };
-  for (double g = 0; g <= tr + 1e-9; g += tstep) {
-    cv::Point p = errPx(t0 + g, 0);
+  }
+};
+
+// Headroom above the largest error.
+constexpr double kErrorHeadroom = 1.1;
+
+// The dashed RMSE line with its labelled box in the panel's top right.
+void drawRmseLine(cv::Mat& img, const ErrorAxes& axes, double rmse) {
+  const cv::Rect& panel = axes.panel;
+  const int y = axes.toPx(axes.t0, rmse).y;
+  for (int x = panel.x; x < panel.x + panel.width; x += 16) {
+    cv::line(img, {x, y}, {std::min(x + 9, panel.x + panel.width), y}, kBlack, 1, cv::LINE_AA);
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "- - rmse %.4f m", rmse);
+  int base = 0;
+  cv::Size sz = cv::getTextSize(buf, kFont, 0.5, 1, &base);
+  const cv::Point at(panel.x + panel.width - sz.width - 10, panel.y + 8);
+  cv::rectangle(img, cv::Rect(at.x - 6, at.y - 2, sz.width + 12, sz.height + 12), kWhite, cv::FILLED);
+  cv::rectangle(img, cv::Rect(at.x - 6, at.y - 2, sz.width + 12, sz.height + 12), kAxisText, 1);
+  text(img, buf, {at.x, at.y + sz.height + 3}, 0.5, kBlack);
+}
+
+void drawErrorPanel(cv::Mat& img, const cv::Rect& panel, const AteResult& ate) {
+  ErrorAxes axes;
+  axes.panel = panel;
+  axes.t0 = ate.gt_stamps.empty() ? 0.0 : ate.gt_stamps.front();
+  const double t1 = ate.gt_stamps.empty() ? 1.0 : ate.gt_stamps.back();
+  axes.tr = std::max(t1 - axes.t0, 1e-3);
+  axes.emax = std::max(ate.stats.max * kErrorHeadroom, 1e-4);
+  const double tstep = niceStep(axes.tr, 10), estep = niceStep(axes.emax, 4);
+  for (double g = 0; g <= axes.tr + 1e-9; g += tstep) {
+    cv::Point p = axes.toPx(axes.t0 + g, 0);
     cv::line(img, {p.x, panel.y}, {p.x, panel.y + panel.height}, kGrid, 1);
     textCentered(img, fmt(g, tstep), {p.x, panel.y + panel.height + 20}, 0.45, kAxisText);
   }
-  for (double g = 0; g <= emax + 1e-12; g += estep) {
-    cv::Point p = errPx(t0, g);
+  for (double g = 0; g <= axes.emax + 1e-12; g += estep) {
+    cv::Point p = axes.toPx(axes.t0, g);
     cv::line(img, {panel.x, p.y}, {panel.x + panel.width, p.y}, kGrid, 1);
     textRight(img, fmt(g, estep), {panel.x - 8, p.y}, 0.45, kAxisText);
   }
   cv::rectangle(img, panel, kAxisText, 1);
   std::vector<cv::Point> ep;
-  for (size_t k = 0; k < ate.errors.size(); ++k) ep.push_back(errPx(ate.gt_stamps[k], ate.errors[k]));
+  for (size_t k = 0; k < ate.errors.size(); ++k) ep.push_back(axes.toPx(ate.gt_stamps[k], ate.errors[k]));
   polyline(img, ep, kErr, 2);
-  {
-    // Dashed rmse line.
-    const int y = errPx(t0, ate.stats.rmse).y;
-    for (int x = panel.x; x < panel.x + panel.width; x += 16) {
-      cv::line(img, {x, y}, {std::min(x + 9, panel.x + panel.width), y}, kBlack, 1, cv::LINE_AA);
-    }
-    char buf[64];
-    std::snprintf(buf, sizeof(buf), "- - rmse %.4f m", ate.stats.rmse);
-    int base = 0;
-    cv::Size sz = cv::getTextSize(buf, kFont, 0.5, 1, &base);
-    const cv::Point at(panel.x + panel.width - sz.width - 10, panel.y + 8);
-    cv::rectangle(img, cv::Rect(at.x - 6, at.y - 2, sz.width + 12, sz.height + 12), kWhite, cv::FILLED);
-    cv::rectangle(img, cv::Rect(at.x - 6, at.y - 2, sz.width + 12, sz.height + 12), kAxisText, 1);
-    text(img, buf, {at.x, at.y + sz.height + 3}, 0.5, kBlack);
-  }
+  drawRmseLine(img, axes, ate.stats.rmse);
   text(img, "translational error [m]", {panel.x, panel.y - 10}, 0.55, kBlack);
-  textCentered(img, "time [s] (from first matched pose)", {panel.x + panel.width / 2, panel.y + panel.height + 44},
-               0.55, kBlack);
+  textCentered(img, "time [s] (from first matched pose)",
+               {panel.x + panel.width / 2, panel.y + panel.height + 44}, 0.55, kBlack);
+}
+
+}  // namespace
+
+cv::Mat renderAtePlot(const Trajectory& gt_in, const Trajectory& est_in, const AteResult& ate,
+                      const std::string& title) {
+  checkPlottable(gt_in, est_in, ate);
+  const int W = 1000, H = 1120;
+  cv::Mat img(H, W, CV_8UC3, kWhite);
+  std::vector<Eigen::Vector3d> gt_pts, est_pts;
+  for (const auto& p : uniqueByStamp(gt_in)) gt_pts.push_back(p.T_wc.translation());
+  for (const auto& p : uniqueByStamp(est_in)) est_pts.push_back(ate.alignment * p.T_wc.translation());
+
+  text(img, title, {20, 34}, 0.75, kBlack, 2);
+  const TopView tv = fitTopView(cv::Rect(90, 60, 880, 720), gt_pts, est_pts);
+  drawTopGrid(img, tv);
+  drawTrajectories(img, tv, ate, gt_pts, est_pts);
+  drawLegend(img, tv);
+  drawErrorPanel(img, cv::Rect(90, 870, 880, 190), ate);
   return img;
 }
 

@@ -171,16 +171,12 @@ bool splittable(const QuadNode& n) {
   return n.idx.size() > 1 && (n.x1 - n.x0 > 1.0f || n.y1 - n.y0 > 1.0f);
 }
 
-// Keeps at most `target` keypoints spread over [x0,x1) x [y0,y1): split the region into
-// quadrants until there are `target` non-empty cells (or no cell can be split), then keep the
-// strongest keypoint of each cell.
-std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kps, float x0,
-                                             float x1, float y0, float y1, int target) {
-  if (target <= 0 || kps.empty()) return {};
+// The region cut into about-square columns, each keypoint in its column; empty columns left out.
+std::vector<QuadNode> initialNodes(const std::vector<cv::KeyPoint>& kps, float x0, float x1,
+                                   float y0, float y1) {
   const float w = x1 - x0, h = y1 - y0;
   const int n_ini = std::max(1, static_cast<int>(std::lround(w / h)));
   const float hx = w / n_ini;
-
   std::vector<QuadNode> nodes(n_ini);
   for (int i = 0; i < n_ini; ++i) {
     nodes[i] = {x0 + hx * i, y0, i + 1 == n_ini ? x1 : x0 + hx * (i + 1), y1, {}};
@@ -192,53 +188,57 @@ std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kp
   nodes.erase(std::remove_if(nodes.begin(), nodes.end(),
                              [](const QuadNode& n) { return n.idx.empty(); }),
               nodes.end());
+  return nodes;
+}
 
-  // Phase 1: split every splittable node per pass while the count stays clearly below target.
-  bool finished = false;
-  int alive = static_cast<int>(nodes.size());
-  while (!finished) {
-    const int prev = alive;
-    std::vector<QuadNode> next;
-    next.reserve(nodes.size() * 4);
-    int n_multi = 0;
-    for (QuadNode& n : nodes) {
-      if (!splittable(n)) {
-        next.push_back(std::move(n));
-        continue;
-      }
-      size_t before = next.size();
-      splitNode(n, kps, next);
-      for (size_t k = before; k < next.size(); ++k) n_multi += next[k].idx.size() > 1 ? 1 : 0;
+// Phase 1, one pass: every splittable node split. Returns how many children hold more than
+// one keypoint.
+int splitEveryNode(std::vector<QuadNode>& nodes, const std::vector<cv::KeyPoint>& kps) {
+  std::vector<QuadNode> next;
+  next.reserve(nodes.size() * 4);
+  int n_multi = 0;
+  for (QuadNode& n : nodes) {
+    if (!splittable(n)) {
+      next.push_back(std::move(n));
+      continue;
     }
-    nodes.swap(next);
-    alive = static_cast<int>(nodes.size());
-    if (alive >= target || alive == prev) {
-      finished = true;
-    } else if (alive + 3 * n_multi > target) {
-      // Phase 2: one more full pass would overshoot, so split the most populated nodes first,
-      // one at a time, and stop as soon as the target is reached.
-      while (!finished) {
-        const int prev2 = alive;
-        std::vector<int> order;
-        for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
-          if (nodes[i].alive && splittable(nodes[i])) order.push_back(i);
-        }
-        std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-          return nodes[a].idx.size() > nodes[b].idx.size();
-        });
-        for (int i : order) {
-          std::vector<QuadNode> children;
-          splitNode(nodes[i], kps, children);
-          nodes[i].alive = false;
-          alive += static_cast<int>(children.size()) - 1;
-          for (QuadNode& c : children) nodes.push_back(std::move(c));
-          if (alive >= target) break;
-        }
-        if (alive >= target || alive == prev2) finished = true;
-      }
-    }
+    size_t before = next.size();
+    splitNode(n, kps, next);
+    for (size_t k = before; k < next.size(); ++k) n_multi += next[k].idx.size() > 1 ? 1 : 0;
   }
+  nodes.swap(next);
+  return n_multi;
+}
 
+// Phase 2: one more full pass would overshoot, so the most populated nodes are split first, one
+// at a time, until `alive` reaches the target or nothing splits. Returns the nodes alive.
+int splitLargestFirst(std::vector<QuadNode>& nodes, const std::vector<cv::KeyPoint>& kps,
+                      int target, int alive) {
+  while (true) {
+    const int prev = alive;
+    std::vector<int> order;
+    for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
+      if (nodes[i].alive && splittable(nodes[i])) order.push_back(i);
+    }
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return nodes[a].idx.size() > nodes[b].idx.size();
+    });
+    for (int i : order) {
+      std::vector<QuadNode> children;
+      splitNode(nodes[i], kps, children);
+      nodes[i].alive = false;
+      alive += static_cast<int>(children.size()) - 1;
+      for (QuadNode& c : children) nodes.push_back(std::move(c));
+      if (alive >= target) break;
+    }
+    if (alive >= target || alive == prev) return alive;
+  }
+}
+
+// The strongest keypoint of each live node; a phase-2 split adds up to 3 nodes at once, so the
+// overshoot is trimmed, weakest first.
+std::vector<cv::KeyPoint> strongestPerNode(const std::vector<QuadNode>& nodes,
+                                           const std::vector<cv::KeyPoint>& kps, int alive, int target) {
   std::vector<cv::KeyPoint> out;
   out.reserve(alive);
   for (const QuadNode& n : nodes) {
@@ -249,7 +249,6 @@ std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kp
     }
     out.push_back(kps[best]);
   }
-  // A phase-2 split adds up to 3 nodes at once: trim the overshoot, weakest first.
   if (static_cast<int>(out.size()) > target) {
     std::stable_sort(out.begin(), out.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
       return a.response > b.response;
@@ -257,6 +256,28 @@ std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kp
     out.resize(target);
   }
   return out;
+}
+
+// Keeps at most `target` keypoints spread over [x0,x1) x [y0,y1): split the region into
+// quadrants until there are `target` non-empty cells (or no cell can be split), then keep the
+// strongest keypoint of each cell.
+std::vector<cv::KeyPoint> distributeQuadtree(const std::vector<cv::KeyPoint>& kps, float x0,
+                                             float x1, float y0, float y1, int target) {
+  if (target <= 0 || kps.empty()) return {};
+  std::vector<QuadNode> nodes = initialNodes(kps, x0, x1, y0, y1);
+  int alive = static_cast<int>(nodes.size());
+  while (true) {
+    const int prev = alive;
+    const int n_multi = splitEveryNode(nodes, kps);
+    alive = static_cast<int>(nodes.size());
+    if (alive >= target || alive == prev) break;
+    // Phase 1 goes on while the count stays clearly below the target.
+    if (alive + 3 * n_multi > target) {
+      alive = splitLargestFirst(nodes, kps, target, alive);
+      break;
+    }
+  }
+  return strongestPerNode(nodes, kps, alive, target);
 }
 
 // Intensity-centroid orientation (Rosin) over the disk of radius 15; degrees in [0, 360).

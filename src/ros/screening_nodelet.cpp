@@ -61,6 +61,17 @@ class ScreeningNodelet : public nodelet::Nodelet {
     pnh.param("sync_max_interval", max_interval, 0.05);
     pnh.param("sync_min_period", sync_min_period_, kDefaultSyncMinPeriodS);
     pnh.param("input_timeout", input_timeout_s_, kDefaultInputTimeoutS);
+    if (!configure(nh, pnh, queue_size)) return;
+    pub_ = nh.advertise<KeypointFrame>("yolo_slam/keypoint_frame", queue_size);
+    startDiagnostics(nh, pnh);
+    subscribeInputs(nh, queue_size, max_interval);
+    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
+    reconfigure_->setCallback([this](ScreeningConfig& c, uint32_t) { onReconfigure(c); });
+  }
+
+  // The settings file and the parameters that override it. False (logged) when they are bad: the
+  // nodelet then stays idle.
+  bool configure(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh, int queue_size) {
     try {
       const Config cfg = loadSettings(pnh);
       const bool rectified = rectifiedInput(pnh, nh.resolveName(kRgbTopic));
@@ -73,29 +84,35 @@ class ScreeningNodelet : public nodelet::Nodelet {
       if (!use_boxes_) screening_options_.tracker.enabled = false;
       orb_options_ = features::OrbOptions::load(cfg);
       front_end_ = std::make_unique<frontend::FrontEnd>(orb_options_, screening_options_);
-      const screening::ScreeningOptions& sopt = screening_options_;
       detection::AsyncDetectionOptions aopt = detection::AsyncDetectionOptions::load(cfg);
       pnh.param("async_detection", aopt.enabled, aopt.enabled);
       async_boxes_ = use_boxes_ && aopt.enabled;
       box_feed_ = std::make_unique<detection::BoxFeed>(aopt.max_age_s);
       NODELET_INFO("Screening: %d ORB features, dynamic mode %s, %s, queue %d, %s images",
-                   front_end_->extractor().options().n_features, screening::toString(sopt.mode).c_str(),
+                   front_end_->extractor().options().n_features, screening::toString(screening_options_.mode).c_str(),
                    !use_boxes_ ? "rgb+depth (no detector)"
                    : async_boxes_ ? "rgb+depth, newest boxes (async)" : "rgb+depth+boxes synchronised",
                    queue_size, rectified ? "rectified" : "raw");
+      return true;
     } catch (const std::exception& e) {
       NODELET_ERROR("Screening: bad settings: %s. The nodelet is idle until restarted with "
                     "valid ~settings", e.what());
-      return;
+      return false;
     }
+  }
 
-    pub_ = nh.advertise<KeypointFrame>("yolo_slam/keypoint_frame", queue_size);
+  void startDiagnostics(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh) {
     diagnostic_updater::Updater& updater = diagnostics_.begin(nh, pnh, getName());
     updater.add("frames", this, &ScreeningNodelet::fillDiagnostics);
     rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
         diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_), "published frame rate");
     updater.add(*rate_);
     diagnostics_.run(nh);
+  }
+
+  // Camera info, colour and depth, and the boxes: synchronised with each frame (every-frame
+  // detection) or the newest kept aside (asynchronous detection, or none without a detector).
+  void subscribeInputs(::ros::NodeHandle& nh, int queue_size, double max_interval) {
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &ScreeningNodelet::onInfo, this);
     rgb_sub_.subscribe(nh, kRgbTopic, queue_size);
@@ -124,8 +141,6 @@ class ScreeningNodelet : public nodelet::Nodelet {
       if (sync_min_period_ > 0) sync2_->setInterMessageLowerBound(::ros::Duration(sync_min_period_));
       sync2_->registerCallback(&ScreeningNodelet::onFrame2, this);
     }
-    reconfigure_ = std::make_unique<ReconfigureServer>(reconfigure_mutex_, pnh);
-    reconfigure_->setCallback([this](ScreeningConfig& c, uint32_t) { onReconfigure(c); });
   }
 
   // cfg/Screening.cfg. Runs on the nodelet's single-threaded queue, as the frame callbacks: the

@@ -100,7 +100,22 @@ class SlamNodelet : public nodelet::Nodelet {
     DenseMapTopicsOptions dense_topics;
     pnh.param("grid_min_height", dense_topics.grid_min_height, DenseMapTopicsOptions::kDefaultGridMinHeight);
     pnh.param("grid_max_height", dense_topics.grid_max_height, DenseMapTopicsOptions::kDefaultGridMaxHeight);
-    std::string settings_path, voc_path;
+    std::string settings_path;
+    if (!configure(nh, pnh, settings_path)) return;
+    advertiseOutputs(nh, pnh);
+    subscribeInputs(nh, queue_size, dense_topics);
+    advertiseServices(nh);
+    // Stopped until the reconfigure server hands over ~map_publish_period.
+    map_timer_ = nh.createWallTimer(::ros::WallDuration(1.0), [this](const ::ros::WallTimerEvent&) { publishMap(); },
+                                    false, false);
+    startReconfigure(pnh);
+    NODELET_INFO("Slam: tf %s, settings '%s'", pose_out_->describe().c_str(), settings_path.c_str());
+  }
+
+  // The pose output, the settings and the vocabulary. False (logged) when one is bad: the nodelet
+  // then stays idle.
+  bool configure(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh, std::string& settings_path) {
+    std::string voc_path;
     pnh.param<std::string>("vocabulary", voc_path, "");
     try {
       pose_out_ = std::make_unique<PoseOutput>(nh, pnh);
@@ -115,18 +130,26 @@ class SlamNodelet : public nodelet::Nodelet {
       } else {
         NODELET_WARN("Slam: no ~vocabulary: relocalisation and loop closing are off");
       }
+      return true;
     } catch (const std::exception& e) {
       NODELET_ERROR("Slam: %s. The nodelet is idle until restarted with valid parameters",
                     e.what());
-      return;
+      return false;
     }
+  }
 
+  void advertiseOutputs(::ros::NodeHandle& nh, ::ros::NodeHandle& pnh) {
     path_pub_ = nh.advertise<nav_msgs::Path>("yolo_slam/path", 1, true);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("yolo_slam/map_points", 1, true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("yolo_slam/keyframes", 1, true);
     image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
     debug_pub_ = image_transport_->advertise("yolo_slam/debug_image", 2);
     startDiagnostics(nh, pnh);
+  }
+
+  // The keypoint frames, camera info, and the colour (and with the dense map, depth) images the
+  // frames were made from; the dense map's topics, service and timer.
+  void subscribeInputs(::ros::NodeHandle& nh, int queue_size, const DenseMapTopicsOptions& dense_topics) {
     // Multi-threaded handle: camera_info is stored even while a frame is being processed.
     info_sub_ = getMTNodeHandle().subscribe("camera/rgb/camera_info", 10, &SlamNodelet::onInfo, this);
     // Colour and depth wait in stamp-indexed caches for the keypoint frame made from them.
@@ -143,17 +166,15 @@ class SlamNodelet : public nodelet::Nodelet {
     }
     frame_sub_ = nh.subscribe("yolo_slam/keypoint_frame", queue_size, &SlamNodelet::onFrame, this,
                               ::ros::TransportHints().tcpNoDelay());
+  }
+
+  void advertiseServices(::ros::NodeHandle& nh) {
     reset_srv_ = nh.advertiseService("yolo_slam/reset", &SlamNodelet::onReset, this);
     save_srv_ = nh.advertiseService("yolo_slam/save_trajectory", &SlamNodelet::onSave, this);
     loc_srv_ = nh.advertiseService("yolo_slam/set_localization_mode", &SlamNodelet::onLocalization,
                                    this);
     save_map_srv_ = nh.advertiseService("yolo_slam/save_map", &SlamNodelet::onSaveMap, this);
     load_map_srv_ = nh.advertiseService("yolo_slam/load_map", &SlamNodelet::onLoadMap, this);
-    // Stopped until the reconfigure server hands over ~map_publish_period.
-    map_timer_ = nh.createWallTimer(::ros::WallDuration(1.0), [this](const ::ros::WallTimerEvent&) { publishMap(); },
-                                    false, false);
-    startReconfigure(pnh);
-    NODELET_INFO("Slam: tf %s, settings '%s'", pose_out_->describe().c_str(), settings_path.c_str());
   }
 
   void onInfo(const sensor_msgs::CameraInfoConstPtr& info) {

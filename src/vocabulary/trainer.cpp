@@ -124,37 +124,46 @@ uint64_t mix(uint64_t x) {  // splitmix64 finaliser: per-node seeds from (seed, 
   return x ^ (x >> 31);
 }
 
-}  // namespace
-
-std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
-                                            const TrainerOptions& opt, TrainingReport* report,
-                                            const std::function<void(size_t, size_t)>& progress) {
-  if (opt.k < 2 || opt.k > 1000)
-    throw Error("vocabulary training: k must be in 2..1000, got " + std::to_string(opt.k));
-  if (opt.levels < 1 || opt.levels > 12)
-    throw Error("vocabulary training: levels must be in 1..12, got " + std::to_string(opt.levels));
+// Every training descriptor, the image it came from, and how many images gave any.
+struct TrainingSet {
   std::vector<Desc> data;
   std::vector<uint32_t> image_of;
+  size_t n_images = 0;
+};
+
+TrainingSet gatherDescriptors(const std::vector<cv::Mat>& images, int k) {
+  TrainingSet t;
   for (size_t i = 0; i < images.size(); ++i) {
     const cv::Mat& m = images[i];
     if (m.empty()) continue;
     if (m.type() != CV_8UC1 || m.cols != kDescriptorBytes)
       throw Error("vocabulary training: image " + std::to_string(i) +
                   " descriptors must be N x 32 CV_8U (ORB)");
+    ++t.n_images;
     for (int r = 0; r < m.rows; ++r) {
       Desc d;
       std::memcpy(d.data(), m.ptr<uint8_t>(r), kDescriptorBytes);
-      data.push_back(d);
-      image_of.push_back(static_cast<uint32_t>(i));
+      t.data.push_back(d);
+      t.image_of.push_back(static_cast<uint32_t>(i));
     }
   }
-  if (data.size() < static_cast<size_t>(opt.k))
-    throw Error("vocabulary training: only " + std::to_string(data.size()) +
-                " descriptors, need at least k=" + std::to_string(opt.k) + "; add more images");
+  if (t.data.size() < static_cast<size_t>(k))
+    throw Error("vocabulary training: only " + std::to_string(t.data.size()) +
+                " descriptors, need at least k=" + std::to_string(k) + "; add more images");
+  return t;
+}
 
-  Stopwatch sw;
+// The tree's nodes: parent and descriptor per node id, node 0 the root.
+struct Nodes {
   std::vector<uint32_t> parents{0};
-  std::vector<Desc> node_desc{Desc{0, 0, 0, 0}};
+  std::vector<Desc> desc{Desc{0, 0, 0, 0}};
+};
+
+// Hierarchical k-majority, breadth-first, so node ids are assigned level by level with each
+// node's children contiguous.
+Nodes growTree(const std::vector<Desc>& data, const TrainerOptions& opt,
+               const std::function<void(size_t, size_t)>& progress) {
+  Nodes nodes;
   const size_t total = data.size() * static_cast<size_t>(opt.levels);
   size_t done = 0;
   std::deque<Work> queue;
@@ -165,7 +174,6 @@ std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
   }
   std::vector<Desc> centres;
   std::vector<std::vector<uint32_t>> groups;
-  // Breadth-first, so node ids are assigned level by level with each node's children contiguous.
   while (!queue.empty()) {
     Work w = std::move(queue.front());
     queue.pop_front();
@@ -173,8 +181,8 @@ std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
     if (w.members.size() <= static_cast<size_t>(opt.k)) {
       // Too few to cluster: each descriptor becomes a leaf (DBoW2 does the same).
       for (uint32_t m : w.members) {
-        parents.push_back(w.node);
-        node_desc.push_back(data[m]);
+        nodes.parents.push_back(w.node);
+        nodes.desc.push_back(data[m]);
       }
       done += w.members.size() * remaining_levels;
     } else {
@@ -182,9 +190,9 @@ std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
       cluster(data, w.members, opt.k, opt.max_iterations, rng, centres, groups);
       done += w.members.size();
       for (size_t c = 0; c < centres.size(); ++c) {
-        const uint32_t id = static_cast<uint32_t>(parents.size());
-        parents.push_back(w.node);
-        node_desc.push_back(centres[c]);
+        const uint32_t id = static_cast<uint32_t>(nodes.parents.size());
+        nodes.parents.push_back(w.node);
+        nodes.desc.push_back(centres[c]);
         if (w.level + 1 < opt.levels && groups[c].size() > 1)
           queue.push_back(Work{id, w.level + 1, std::move(groups[c])});
         else
@@ -193,65 +201,95 @@ std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
     }
     if (progress) progress(done, total);
   }
+  return nodes;
+}
+
+// Per word: how many training descriptors and how many images reach it.
+struct WordCounts {
+  std::vector<uint32_t> descriptors, images;
+};
+
+WordCounts countWords(const Vocabulary& tree, const TrainingSet& t) {
+  const size_t words = tree.size();
+  WordCounts c{std::vector<uint32_t>(words, 0), std::vector<uint32_t>(words, 0)};
+  std::vector<uint32_t> last_image(words, 0xffffffffu);
+  for (size_t i = 0; i < t.data.size(); ++i) {
+    const uint32_t w = tree.transform(reinterpret_cast<const uint8_t*>(t.data[i].data()));
+    ++c.descriptors[w];
+    if (last_image[w] != t.image_of[i]) {
+      last_image[w] = t.image_of[i];
+      ++c.images[w];
+    }
+  }
+  return c;
+}
+
+// Node weights: IDF on the words (when the weighting uses it, else 1), 0 on inner nodes (never
+// used; keeps files comparable with DBoW2's).
+std::vector<double> nodeWeights(const Vocabulary& tree, const Nodes& nodes, const WordCounts& c,
+                                size_t n_images, Weighting weighting) {
+  const size_t n = nodes.parents.size();
+  std::vector<double> weights(n, 1.0);
+  if (weighting == Weighting::TfIdf || weighting == Weighting::Idf) {
+    for (size_t w = 0; w < c.images.size(); ++w) {
+      // As DBoW2: log(N / n_i); words no training image reaches keep weight 0 (ignored).
+      const double idf = c.images[w] > 0 ? std::log(static_cast<double>(n_images) / c.images[w]) : 0.0;
+      weights[tree.wordNode(static_cast<WordId>(w))] = idf;
+    }
+  }
+  std::vector<uint8_t> is_leaf(n, 1);
+  for (size_t i = 1; i < n; ++i) is_leaf[nodes.parents[i]] = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (!is_leaf[i]) weights[i] = 0.0;
+  return weights;
+}
+
+void fillReport(const TrainerOptions& opt, const TrainingSet& t, size_t n_nodes, const WordCounts& c,
+                TrainingReport& report) {
+  report.images = t.n_images;
+  report.descriptors = t.data.size();
+  report.nodes = n_nodes;
+  report.words = c.descriptors.size();
+  report.capacity = std::pow(static_cast<double>(opt.k), opt.levels);
+  std::vector<double> counts;
+  for (size_t w = 0; w < c.descriptors.size(); ++w) {
+    if (c.descriptors[w] > 0) ++report.words_hit;
+    if (c.images[w] >= 2) ++report.words_in_two_images;
+    counts.push_back(c.descriptors[w]);
+  }
+  const Summary s = summarize(counts);
+  report.mean_descriptors_per_word = s.mean;
+  report.median_descriptors_per_word = s.median;
+}
+
+}  // namespace
+
+std::shared_ptr<Vocabulary> trainVocabulary(const std::vector<cv::Mat>& images,
+                                            const TrainerOptions& opt, TrainingReport* report,
+                                            const std::function<void(size_t, size_t)>& progress) {
+  if (opt.k < 2 || opt.k > 1000)
+    throw Error("vocabulary training: k must be in 2..1000, got " + std::to_string(opt.k));
+  if (opt.levels < 1 || opt.levels > 12)
+    throw Error("vocabulary training: levels must be in 1..12, got " + std::to_string(opt.levels));
+  const TrainingSet t = gatherDescriptors(images, opt.k);
+
+  Stopwatch sw;
+  const Nodes nodes = growTree(t.data, opt, progress);
   const double cluster_s = sw.ms() / 1000.0;
   sw.restart();
 
-  const size_t n = parents.size();
+  // The tree alone (unit weights) gives each training descriptor its word; the weights follow.
+  const size_t n = nodes.parents.size();
   std::vector<uint8_t> desc(n * kDescriptorBytes);
-  for (size_t i = 0; i < n; ++i) std::memcpy(&desc[i * kDescriptorBytes], node_desc[i].data(), kDescriptorBytes);
-  std::vector<double> weights(n, 1.0);
-  auto tree = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, parents, desc,
-                                    weights, {}, "vocabulary training");
-
-  // Words of the training descriptors: per-word descriptor counts and image counts (IDF).
-  std::vector<uint32_t> word_of(data.size());
-  for (size_t i = 0; i < data.size(); ++i)
-    word_of[i] = tree->transform(reinterpret_cast<const uint8_t*>(data[i].data()));
-  const size_t words = tree->size();
-  std::vector<uint32_t> desc_count(words, 0), image_count(words, 0), last_image(words, 0xffffffffu);
-  size_t n_images = 0;
-  for (size_t i = 0; i < data.size(); ++i) {
-    const uint32_t w = word_of[i];
-    ++desc_count[w];
-    if (last_image[w] != image_of[i]) {
-      last_image[w] = image_of[i];
-      ++image_count[w];
-    }
-  }
-  for (const cv::Mat& m : images) n_images += m.empty() ? 0 : 1;
-  if (opt.weighting == Weighting::TfIdf || opt.weighting == Weighting::Idf) {
-    for (size_t w = 0; w < words; ++w) {
-      // As DBoW2: log(N / n_i); words no training image reaches keep weight 0 (ignored).
-      const double idf = image_count[w] > 0
-                             ? std::log(static_cast<double>(n_images) / image_count[w])
-                             : 0.0;
-      weights[tree->wordNode(static_cast<WordId>(w))] = idf;
-    }
-  }
-  // Inner nodes: weight 0 (never used; keeps files comparable with DBoW2's).
-  {
-    std::vector<uint8_t> is_leaf(n, 1);
-    for (size_t i = 1; i < n; ++i) is_leaf[parents[i]] = 0;
-    for (size_t i = 0; i < n; ++i)
-      if (!is_leaf[i]) weights[i] = 0.0;
-  }
-  auto vocab = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, parents, desc,
-                                     weights, {}, "vocabulary training");
+  for (size_t i = 0; i < n; ++i) std::memcpy(&desc[i * kDescriptorBytes], nodes.desc[i].data(), kDescriptorBytes);
+  auto tree = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, nodes.parents, desc,
+                                    std::vector<double>(n, 1.0), {}, "vocabulary training");
+  const WordCounts counts = countWords(*tree, t);
+  auto vocab = Vocabulary::fromNodes(opt.k, opt.levels, opt.weighting, Scoring::L1, nodes.parents, desc,
+                                     nodeWeights(*tree, nodes, counts, t.n_images, opt.weighting), {},
+                                     "vocabulary training");
   if (report) {
-    report->images = n_images;
-    report->descriptors = data.size();
-    report->nodes = n;
-    report->words = words;
-    report->capacity = std::pow(static_cast<double>(opt.k), opt.levels);
-    std::vector<double> counts;
-    for (size_t w = 0; w < words; ++w) {
-      if (desc_count[w] > 0) ++report->words_hit;
-      if (image_count[w] >= 2) ++report->words_in_two_images;
-      counts.push_back(desc_count[w]);
-    }
-    const Summary s = summarize(counts);
-    report->mean_descriptors_per_word = s.mean;
-    report->median_descriptors_per_word = s.median;
+    fillReport(opt, t, n, counts, *report);
     report->cluster_seconds = cluster_s;
     report->weight_seconds = sw.ms() / 1000.0;
   }

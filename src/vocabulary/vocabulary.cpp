@@ -20,6 +20,70 @@ std::string toString(Weighting w) {
   return "unknown";
 }
 
+namespace {
+
+void checkNodeArrays(int k, int levels, const std::vector<uint32_t>& parents, size_t n_descriptor_bytes,
+                     size_t n_weights, size_t n_word_ids, const std::string& name) {
+  const size_t n = parents.size();
+  if (k < 2 || levels < 1 || levels > 32)
+    throw Error(name + ": invalid vocabulary shape k=" + std::to_string(k) + " L=" +
+                std::to_string(levels) + " (need k >= 2, 1 <= L <= 32)");
+  if (n < 2) throw Error(name + ": vocabulary has no words (node count " + std::to_string(n) + ")");
+  if (n > 0xfffffff0u) throw Error(name + ": too many nodes");
+  if (n_descriptor_bytes != n * kDescriptorBytes || n_weights != n || (n_word_ids != 0 && n_word_ids != n))
+    throw Error(name + ": node arrays have inconsistent sizes");
+  for (size_t i = 1; i < n; ++i)
+    if (parents[i] >= n || parents[i] == i)
+      throw Error(name + ": node " + std::to_string(i) + " has invalid parent " +
+                  std::to_string(parents[i]));
+}
+
+// Our layout: parent before child, parents non-decreasing, so each node's children are
+// contiguous (the case for files we wrote).
+bool inOurLayout(const std::vector<uint32_t>& parents) {
+  for (size_t i = 1; i < parents.size(); ++i)
+    if (!(parents[i] < i && (i == 1 || parents[i] >= parents[i - 1]))) return false;
+  return true;
+}
+
+// The nodes in breadth-first order from the root (new index -> old index).
+std::vector<uint32_t> breadthFirstOrder(const std::vector<uint32_t>& parents, const std::string& name) {
+  const size_t n = parents.size();
+  std::vector<uint32_t> count(n + 1, 0);
+  for (size_t i = 1; i < n; ++i) ++count[parents[i] + 1];
+  for (size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
+  std::vector<uint32_t> kids(n > 0 ? n - 1 : 0);
+  std::vector<uint32_t> fill(count.begin(), count.end() - 1);
+  for (size_t i = 1; i < n; ++i) kids[fill[parents[i]]++] = static_cast<uint32_t>(i);
+  std::vector<uint32_t> order;
+  order.reserve(n);
+  order.push_back(0);
+  for (size_t h = 0; h < order.size(); ++h) {
+    const uint32_t o = order[h];
+    for (uint32_t j = count[o]; j < count[o + 1]; ++j) order.push_back(kids[j]);
+  }
+  if (order.size() != n)
+    throw Error(name + ": node parents form a cycle or unreachable nodes (" +
+                std::to_string(n - order.size()) + " nodes not under the root)");
+  return order;
+}
+
+// Word ids (new node index -> word) numbering the leaves in the input's node order, as DBoW2
+// does for ORBvoc.txt.
+std::vector<uint32_t> leafWordsInInputOrder(const std::vector<uint32_t>& parents,
+                                            const std::vector<uint32_t>& new_of_old) {
+  const size_t n = parents.size();
+  std::vector<uint32_t> has_child(n, 0);
+  for (size_t i = 1; i < n; ++i) has_child[parents[i]] = 1;
+  std::vector<uint32_t> word_of_node(n, Vocabulary::kNoWord);
+  uint32_t next = 0;
+  for (size_t o = 1; o < n; ++o)
+    if (!has_child[o]) word_of_node[new_of_old[o]] = next++;
+  return word_of_node;
+}
+
+}  // namespace
+
 std::shared_ptr<Vocabulary> Vocabulary::fromNodes(int k, int levels, Weighting weighting,
                                                   Scoring scoring,
                                                   std::vector<uint32_t> parents,
@@ -27,56 +91,20 @@ std::shared_ptr<Vocabulary> Vocabulary::fromNodes(int k, int levels, Weighting w
                                                   std::vector<double> weights,
                                                   std::vector<uint32_t> word_ids,
                                                   const std::string& name) {
+  checkNodeArrays(k, levels, parents, descriptors.size(), weights.size(), word_ids.size(), name);
   const size_t n = parents.size();
-  if (k < 2 || levels < 1 || levels > 32)
-    throw Error(name + ": invalid vocabulary shape k=" + std::to_string(k) + " L=" +
-                std::to_string(levels) + " (need k >= 2, 1 <= L <= 32)");
-  if (n < 2) throw Error(name + ": vocabulary has no words (node count " + std::to_string(n) + ")");
-  if (n > 0xfffffff0u) throw Error(name + ": too many nodes");
-  if (descriptors.size() != n * kDescriptorBytes || weights.size() != n ||
-      (!word_ids.empty() && word_ids.size() != n))
-    throw Error(name + ": node arrays have inconsistent sizes");
-  for (size_t i = 1; i < n; ++i)
-    if (parents[i] >= n || parents[i] == i)
-      throw Error(name + ": node " + std::to_string(i) + " has invalid parent " +
-                  std::to_string(parents[i]));
-
-  // Already in our layout (parent before child, parents non-decreasing, so each node's children
-  // are contiguous) -- the case for files we wrote; otherwise relabel breadth-first.
-  bool ordered = true;
-  for (size_t i = 1; i < n && ordered; ++i)
-    ordered = parents[i] < i && (i == 1 || parents[i] >= parents[i - 1]);
-
-  std::vector<uint32_t> order;  // new index -> old index
-  if (!ordered) {
-    std::vector<uint32_t> count(n + 1, 0);
-    for (size_t i = 1; i < n; ++i) ++count[parents[i] + 1];
-    for (size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
-    std::vector<uint32_t> kids(n > 0 ? n - 1 : 0);
-    std::vector<uint32_t> fill(count.begin(), count.end() - 1);
-    for (size_t i = 1; i < n; ++i) kids[fill[parents[i]]++] = static_cast<uint32_t>(i);
-    order.reserve(n);
-    order.push_back(0);
-    for (size_t h = 0; h < order.size(); ++h) {
-      const uint32_t o = order[h];
-      for (uint32_t j = count[o]; j < count[o + 1]; ++j) order.push_back(kids[j]);
-    }
-    if (order.size() != n)
-      throw Error(name + ": node parents form a cycle or unreachable nodes (" +
-                  std::to_string(n - order.size()) + " nodes not under the root)");
-  }
-
   auto v = std::shared_ptr<Vocabulary>(new Vocabulary());
   v->k_ = k;
   v->levels_ = levels;
   v->weighting_ = weighting;
   v->scoring_ = scoring;
-  if (ordered) {
+  if (inOurLayout(parents)) {
     v->parent_ = std::move(parents);
     v->desc_ = std::move(descriptors);
     v->weight_ = std::move(weights);
     v->word_of_node_ = std::move(word_ids);
   } else {
+    const std::vector<uint32_t> order = breadthFirstOrder(parents, name);
     std::vector<uint32_t> new_of_old(n);
     for (size_t i = 0; i < n; ++i) new_of_old[order[i]] = static_cast<uint32_t>(i);
     v->parent_.resize(n);
@@ -90,15 +118,7 @@ std::shared_ptr<Vocabulary> Vocabulary::fromNodes(int k, int levels, Weighting w
       v->weight_[i] = weights[o];
       if (!word_ids.empty()) v->word_of_node_[i] = word_ids[o];
     }
-    if (word_ids.empty()) {
-      // Number the leaves in the input's node order (what DBoW2 does for ORBvoc.txt).
-      std::vector<uint32_t> has_child(n, 0);
-      for (size_t i = 1; i < n; ++i) has_child[parents[i]] = 1;
-      v->word_of_node_.assign(n, kNoWord);
-      uint32_t next = 0;
-      for (size_t o = 1; o < n; ++o)
-        if (!has_child[o]) v->word_of_node_[new_of_old[o]] = next++;
-    }
+    if (word_ids.empty()) v->word_of_node_ = leafWordsInInputOrder(parents, new_of_old);
   }
   v->parent_[0] = 0;
   v->buildChildren(name);
