@@ -48,76 +48,103 @@ static double parseGain(const std::string& flag, const std::string& v) {
   return x;
 }
 
+// The command line; unset numbers are negative, unset strings empty.
+struct Args {
+  std::string out, config, sheet, preset, textures, trajectory;
+  std::vector<std::string> sheet_presets;
+  bool help = false, list_presets = false, list_textures = false, blur = false, no_noise = false,
+       no_objects = false;
+  double people_detail = -1;
+  int threads = -1;
+  long seed = -1, frames = -1;
+};
+
+static Args parseArgs(int argc, char** argv) {
+  Args g;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto val = [&]() -> std::string {
+      if (i + 1 >= argc) throw Error("missing value after " + a + " (see --help)");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") { g.help = true; return g; }
+    else if (a == "--out") g.out = val();
+    else if (a == "--preset") g.preset = val(), g.sheet_presets.push_back(g.preset);
+    else if (a == "--contact-sheet") g.sheet = val();
+    else if (a == "--seed") g.seed = parseInt(a, val(), 0);
+    else if (a == "--frames") g.frames = parseInt(a, val(), 0);
+    else if (a == "--textures") g.textures = val();
+    else if (a == "--trajectory") g.trajectory = val();
+    else if (a == "--config") g.config = val();
+    else if (a == "--threads") g.threads = (int)parseInt(a, val(), 1);
+    else if (a == "--motion-blur") g.blur = true;
+    else if (a == "--no-noise") g.no_noise = true;
+    else if (a == "--no-objects") g.no_objects = true;
+    else if (a == "--people-detail") g.people_detail = parseGain(a, val());
+    else if (a == "--list-presets") g.list_presets = true;
+    else if (a == "--list-textures") g.list_textures = true;
+    else throw Error("unknown argument '" + a + "' (see --help)");
+  }
+  return g;
+}
+
+// The options of --config (or the defaults), with what the command line sets over them.
+static sim::SynthOptions synthOptions(const Args& g) {
+  sim::SynthOptions opt;
+  if (!g.config.empty()) opt = sim::SynthOptions::load(Config::fromFile(g.config));
+  if (!g.preset.empty()) opt.preset = g.preset;
+  if (g.seed >= 0) opt.seed = (unsigned)g.seed;
+  if (g.frames >= 0) opt.frames = (int)g.frames;
+  if (!g.textures.empty()) opt.textures_dir = g.textures;
+  if (!g.trajectory.empty()) opt.trajectory = g.trajectory;
+  if (g.threads > 0) opt.threads = g.threads;
+  if (g.blur) opt.sensor.motion_blur = true;
+  if (g.no_noise) opt.sensor.noise = false;
+  if (g.no_objects) opt.objects = false;
+  if (g.people_detail >= 0) opt.people_detail = g.people_detail;
+  return opt;
+}
+
+static void listPresets() {
+  for (const auto& p : sim::presets())
+    std::printf("%-15s %5d frames  motion %-10s  %s\n", p.name.c_str(), p.frames, p.motion.c_str(),
+                p.description.c_str());
+}
+
+static void listTextures(const sim::SynthOptions& opt) {
+  std::string dir = opt.textures_dir.empty() ? sim::defaultTextureDir() : opt.textures_dir;
+  for (const auto& f : sim::listTextureFiles(dir)) std::printf("%s/%s\n", dir.c_str(), f.c_str());
+}
+
+static void writeContactSheet(const sim::SynthOptions& opt, std::vector<std::string> presets,
+                              const std::string& path) {
+  if (presets.empty())
+    for (const auto& p : sim::presets()) presets.push_back(p.name);
+  cv::Mat img = sim::contactSheet(opt, presets, {0, 300}, 200);
+  if (!cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
+    throw Error("cannot write contact sheet " + path + ": check the folder exists and is writable");
+}
+
+static void generate(const sim::SynthOptions& opt, const std::string& out) {
+  if (out.empty()) throw Error("--out DIR is required (see --help)");
+  sim::SequenceGenerator gen(opt);
+  double s = gen.generate(out, isatty(2));
+  std::fprintf(stderr, "yolo_slam_synth: %zu frames of '%s' in %s (%.1f s, %.1f frames/s)\n", gen.size(),
+               opt.preset.c_str(), out.c_str(), s, gen.size() / std::max(s, 1e-9));
+}
+
 int main(int argc, char** argv) {
   try {
-    sim::SynthOptions opt;
-    std::string out, config, sheet;
-    std::vector<std::string> sheet_presets;
-    bool list_presets = false, list_textures = false, blur = false, no_noise = false, no_objects = false;
-    double people_detail = -1;
-    int threads = -1;
-    long seed = -1, frames = -1;
-    std::string preset, textures, trajectory;
-    for (int i = 1; i < argc; ++i) {
-      std::string a = argv[i];
-      auto val = [&]() -> std::string {
-        if (i + 1 >= argc) throw Error("missing value after " + a + " (see --help)");
-        return argv[++i];
-      };
-      if (a == "-h" || a == "--help") { usage(); return 0; }
-      else if (a == "--out") out = val();
-      else if (a == "--preset") preset = val(), sheet_presets.push_back(preset);
-      else if (a == "--contact-sheet") sheet = val();
-      else if (a == "--seed") seed = parseInt(a, val(), 0);
-      else if (a == "--frames") frames = parseInt(a, val(), 0);
-      else if (a == "--textures") textures = val();
-      else if (a == "--trajectory") trajectory = val();
-      else if (a == "--config") config = val();
-      else if (a == "--threads") threads = (int)parseInt(a, val(), 1);
-      else if (a == "--motion-blur") blur = true;
-      else if (a == "--no-noise") no_noise = true;
-      else if (a == "--no-objects") no_objects = true;
-      else if (a == "--people-detail") people_detail = parseGain(a, val());
-      else if (a == "--list-presets") list_presets = true;
-      else if (a == "--list-textures") list_textures = true;
-      else throw Error("unknown argument '" + a + "' (see --help)");
-    }
-    if (!config.empty()) opt = sim::SynthOptions::load(Config::fromFile(config));
-    if (!preset.empty()) opt.preset = preset;
-    if (seed >= 0) opt.seed = (unsigned)seed;
-    if (frames >= 0) opt.frames = (int)frames;
-    if (!textures.empty()) opt.textures_dir = textures;
-    if (!trajectory.empty()) opt.trajectory = trajectory;
-    if (threads > 0) opt.threads = threads;
-    if (blur) opt.sensor.motion_blur = true;
-    if (no_noise) opt.sensor.noise = false;
-    if (no_objects) opt.objects = false;
-    if (people_detail >= 0) opt.people_detail = people_detail;
-
-    if (list_presets) {
-      for (const auto& p : sim::presets())
-        std::printf("%-15s %5d frames  motion %-10s  %s\n", p.name.c_str(), p.frames, p.motion.c_str(),
-                    p.description.c_str());
+    const Args args = parseArgs(argc, argv);
+    if (args.help) {
+      usage();
       return 0;
     }
-    if (list_textures) {
-      std::string dir = opt.textures_dir.empty() ? sim::defaultTextureDir() : opt.textures_dir;
-      for (const auto& f : sim::listTextureFiles(dir)) std::printf("%s/%s\n", dir.c_str(), f.c_str());
-      return 0;
-    }
-    if (!sheet.empty()) {
-      if (sheet_presets.empty())
-        for (const auto& p : sim::presets()) sheet_presets.push_back(p.name);
-      cv::Mat img = sim::contactSheet(opt, sheet_presets, {0, 300}, 200);
-      if (!cv::imwrite(sheet, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
-        throw Error("cannot write contact sheet " + sheet + ": check the folder exists and is writable");
-      return 0;
-    }
-    if (out.empty()) throw Error("--out DIR is required (see --help)");
-    sim::SequenceGenerator gen(opt);
-    double s = gen.generate(out, isatty(2));
-    std::fprintf(stderr, "yolo_slam_synth: %zu frames of '%s' in %s (%.1f s, %.1f frames/s)\n", gen.size(),
-                 opt.preset.c_str(), out.c_str(), s, gen.size() / std::max(s, 1e-9));
+    const sim::SynthOptions opt = synthOptions(args);
+    if (args.list_presets) listPresets();
+    else if (args.list_textures) listTextures(opt);
+    else if (!args.sheet.empty()) writeContactSheet(opt, args.sheet_presets, args.sheet);
+    else generate(opt, args.out);
     return 0;
   } catch (const std::exception& e) {
     std::string msg = e.what();

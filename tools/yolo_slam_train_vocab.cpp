@@ -48,13 +48,18 @@ vocabulary::Weighting parseWeighting(const std::string& v) {
   throw Error("--weighting: expected tf-idf, tf, idf or binary, got '" + v + "'");
 }
 
-int run(int argc, char** argv) {
+struct Args {
   std::string out;
-  vocabulary::TrainerOptions topt;
-  vocabulary::InputOptions iopt;
+  vocabulary::TrainerOptions trainer;
+  vocabulary::InputOptions inputs_options;
   features::OrbOptions orb;
   bool text = false;
+  bool help = false;
   std::vector<std::string> inputs;
+};
+
+Args parseArgs(int argc, char** argv) {
+  Args args;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -62,58 +67,46 @@ int run(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return 0;
-    } else if (a == "--out") out = value();
-    else if (a == "--k") topt.k = parseInt(a, value(), 2, 1000);
-    else if (a == "--levels") topt.levels = parseInt(a, value(), 1, 12);
-    else if (a == "--max-features") orb.n_features = parseInt(a, value(), 10, 100000);
-    else if (a == "--video-step") iopt.video_step = parseInt(a, value(), 1, 1000000);
-    else if (a == "--max-video-frames") iopt.max_video_frames = parseInt(a, value(), 0, 100000000);
-    else if (a == "--seed") topt.seed = static_cast<uint64_t>(parseInt(a, value(), 0, 2147483647));
-    else if (a == "--iterations") topt.max_iterations = parseInt(a, value(), 1, 1000);
-    else if (a == "--weighting") topt.weighting = parseWeighting(value());
-    else if (a == "--text") text = true;
+      args.help = true;
+      return args;
+    } else if (a == "--out") args.out = value();
+    else if (a == "--k") args.trainer.k = parseInt(a, value(), 2, 1000);
+    else if (a == "--levels") args.trainer.levels = parseInt(a, value(), 1, 12);
+    else if (a == "--max-features") args.orb.n_features = parseInt(a, value(), 10, 100000);
+    else if (a == "--video-step") args.inputs_options.video_step = parseInt(a, value(), 1, 1000000);
+    else if (a == "--max-video-frames") args.inputs_options.max_video_frames = parseInt(a, value(), 0, 100000000);
+    else if (a == "--seed") args.trainer.seed = static_cast<uint64_t>(parseInt(a, value(), 0, 2147483647));
+    else if (a == "--iterations") args.trainer.max_iterations = parseInt(a, value(), 1, 1000);
+    else if (a == "--weighting") args.trainer.weighting = parseWeighting(value());
+    else if (a == "--text") args.text = true;
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see --help)");
-    else inputs.push_back(a);
+    else args.inputs.push_back(a);
   }
-  if (out.empty()) throw Error("--out FILE is required (see --help)");
-  if (inputs.empty()) throw Error("no INPUT given: pass image folders, lists or videos (see --help)");
+  if (args.out.empty()) throw Error("--out FILE is required (see --help)");
+  if (args.inputs.empty()) throw Error("no INPUT given: pass image folders, lists or videos (see --help)");
+  return args;
+}
 
-  Stopwatch total;
-  const auto items = vocabulary::expandInputs(inputs, iopt);
-  std::cout << "inputs: " << items.size() << " images/frames from " << inputs.size() << " inputs\n";
-  const auto grays = vocabulary::loadGrayImages(items);
-
+// ORB descriptors of every image, with a progress bar.
+std::vector<cv::Mat> extractDescriptors(const std::vector<cv::Mat>& grays, const features::OrbOptions& orb) {
   features::OrbExtractor extractor(orb);
   std::vector<cv::Mat> descriptors(grays.size());
   size_t n_desc = 0;
-  {
-    Stopwatch sw;
-    ProgressBar bar("extract", grays.size());
-    for (size_t i = 0; i < grays.size(); ++i) {
-      std::vector<cv::KeyPoint> kps;
-      extractor.extract(grays[i], kps, descriptors[i]);
-      n_desc += static_cast<size_t>(descriptors[i].rows);
-      bar.update(i + 1);
-    }
-    bar.finish();
-    std::printf("extracted %zu descriptors (max %d per image) in %.1f s\n", n_desc, orb.n_features,
-                sw.ms() / 1000.0);
+  Stopwatch sw;
+  ProgressBar bar("extract", grays.size());
+  for (size_t i = 0; i < grays.size(); ++i) {
+    std::vector<cv::KeyPoint> kps;
+    extractor.extract(grays[i], kps, descriptors[i]);
+    n_desc += static_cast<size_t>(descriptors[i].rows);
+    bar.update(i + 1);
   }
+  bar.finish();
+  std::printf("extracted %zu descriptors (max %d per image) in %.1f s\n", n_desc, orb.n_features,
+              sw.ms() / 1000.0);
+  return descriptors;
+}
 
-  vocabulary::TrainingReport rep;
-  std::shared_ptr<vocabulary::Vocabulary> voc;
-  {
-    ProgressBar bar("cluster", 1000);
-    voc = vocabulary::trainVocabulary(descriptors, topt, &rep, [&](size_t done, size_t tot) {
-      bar.update(tot ? done * 1000 / tot : 0);
-    });
-    bar.finish();
-  }
-  if (text) voc->saveText(out);
-  else voc->save(out);
-
+void printReport(const vocabulary::TrainerOptions& topt, const vocabulary::TrainingReport& rep, double total_s) {
   std::printf("k=%d L=%d weighting=%s seed=%llu\n", topt.k, topt.levels,
               vocabulary::toString(topt.weighting).c_str(), static_cast<unsigned long long>(topt.seed));
   std::printf("images: %zu  descriptors: %zu\n", rep.images, rep.descriptors);
@@ -125,8 +118,33 @@ int run(int argc, char** argv) {
               100.0 * rep.words_in_two_images / rep.words, rep.mean_descriptors_per_word,
               rep.median_descriptors_per_word);
   std::printf("timing: clustering %.1f s, weights %.1f s, total %.1f s\n", rep.cluster_seconds,
-              rep.weight_seconds, total.ms() / 1000.0);
-  std::printf("wrote %s\n", out.c_str());
+              rep.weight_seconds, total_s);
+}
+
+int run(int argc, char** argv) {
+  const Args args = parseArgs(argc, argv);
+  if (args.help) {
+    std::cout << kUsage;
+    return 0;
+  }
+  Stopwatch total;
+  const auto items = vocabulary::expandInputs(args.inputs, args.inputs_options);
+  std::cout << "inputs: " << items.size() << " images/frames from " << args.inputs.size() << " inputs\n";
+  const std::vector<cv::Mat> descriptors = extractDescriptors(vocabulary::loadGrayImages(items), args.orb);
+
+  vocabulary::TrainingReport rep;
+  std::shared_ptr<vocabulary::Vocabulary> voc;
+  {
+    ProgressBar bar("cluster", 1000);
+    voc = vocabulary::trainVocabulary(descriptors, args.trainer, &rep, [&](size_t done, size_t tot) {
+      bar.update(tot ? done * 1000 / tot : 0);
+    });
+    bar.finish();
+  }
+  if (args.text) voc->saveText(args.out);
+  else voc->save(args.out);
+  printReport(args.trainer, rep, total.ms() / 1000.0);
+  std::printf("wrote %s\n", args.out.c_str());
   return 0;
 }
 
