@@ -294,6 +294,67 @@ struct LineParser {
   }
 };
 
+// ORB-SLAM2 text layout: the header line 'k L scoring weighting'.
+struct TextHeader {
+  int k = 0, levels = 0;
+  Weighting weighting = Weighting::TfIdf;
+  Scoring scoring = Scoring::L1;
+};
+
+TextHeader parseTextHeader(LineParser& lp, const std::string& where) {
+  TextHeader h;
+  h.k = static_cast<int>(lp.integer("k"));
+  h.levels = static_cast<int>(lp.integer("L"));
+  h.scoring = parseScoring(lp.integer("scoring type"), where);
+  h.weighting = parseWeighting(lp.integer("weighting type"), where);
+  if (!lp.atEnd()) lp.fail("unexpected text after 'k L scoring weighting'");
+  if (h.k < 2 || h.levels < 1) lp.fail("invalid k=" + std::to_string(h.k) + " L=" + std::to_string(h.levels));
+  return h;
+}
+
+// The nodes read so far (node 0 the root, which has no descriptor) and where each came from.
+struct TextNodes {
+  std::vector<uint32_t> parents{0};
+  std::vector<uint8_t> desc = std::vector<uint8_t>(kDescriptorBytes, 0);
+  std::vector<double> weights{0.0};
+  std::vector<uint8_t> declared_leaf{0};
+  std::vector<size_t> node_line{0};
+};
+
+// One node line: 'parent is_leaf byte x 32 weight'.
+void parseNodeLine(LineParser& lp, size_t line_no, TextNodes& t) {
+  const long pid = lp.integer("parent id");
+  const long leaf = lp.integer("is_leaf flag");
+  if (pid < 0 || static_cast<size_t>(pid) >= t.parents.size())
+    lp.fail("parent id " + std::to_string(pid) + " does not name an earlier node (nodes so far: " +
+            std::to_string(t.parents.size()) + ")");
+  if (leaf != 0 && leaf != 1) lp.fail("is_leaf must be 0 or 1, got " + std::to_string(leaf));
+  if (t.declared_leaf[pid])
+    lp.fail("parent " + std::to_string(pid) + " was declared a leaf (line " +
+            std::to_string(t.node_line[pid]) + ")");
+  for (int b = 0; b < kDescriptorBytes; ++b) {
+    const long v = lp.integer("descriptor byte");
+    if (v < 0 || v > 255) lp.fail("descriptor byte " + std::to_string(v) + " out of 0..255");
+    t.desc.push_back(static_cast<uint8_t>(v));
+  }
+  const double w = lp.real("weight");
+  if (!lp.atEnd()) lp.fail("unexpected text after the weight (expected 32 descriptor bytes then one weight)");
+  t.parents.push_back(static_cast<uint32_t>(pid));
+  t.weights.push_back(w);
+  t.declared_leaf.push_back(static_cast<uint8_t>(leaf));
+  t.node_line.push_back(line_no);
+}
+
+// A node declared inner must have children (else it would silently swallow descriptors).
+void checkInnerNodesHaveChildren(const TextNodes& t, const std::string& path) {
+  std::vector<uint8_t> has_child(t.parents.size(), 0);
+  for (size_t i = 1; i < t.parents.size(); ++i) has_child[t.parents[i]] = 1;
+  for (size_t i = 1; i < t.parents.size(); ++i)
+    if (!t.declared_leaf[i] && !has_child[i])
+      throw Error(path + ":" + std::to_string(t.node_line[i]) + ": node " + std::to_string(i) +
+                  " is declared inner (is_leaf 0) but has no children");
+}
+
 }  // namespace
 
 std::shared_ptr<Vocabulary> Vocabulary::loadBinary(const std::string& path) { return readBinary(path); }
@@ -310,15 +371,9 @@ std::shared_ptr<Vocabulary> Vocabulary::loadText(const std::string& path) {
   const char* p = reinterpret_cast<const char*>(buf.data());
   const char* end = p + text_bytes;
   size_t line_no = 0;
-  int k = 0, levels = 0;
-  Weighting weighting = Weighting::TfIdf;
-  Scoring scoring = Scoring::L1;
-  std::vector<uint32_t> parents{0};
-  std::vector<uint8_t> desc(kDescriptorBytes, 0);  // root has no descriptor
-  std::vector<double> weights{0.0};
-  std::vector<uint8_t> declared_leaf{0};
-  std::vector<size_t> node_line{0};
-  bool header = false;
+  TextHeader header;
+  bool have_header = false;
+  TextNodes nodes;
   while (p < end) {
     const char* nl = static_cast<const char*>(std::memchr(p, '\n', end - p));
     const char* le = nl ? nl : end;
@@ -327,46 +382,17 @@ std::shared_ptr<Vocabulary> Vocabulary::loadText(const std::string& path) {
     LineParser lp{p, le, where};
     p = nl ? nl + 1 : end;
     if (lp.atEnd()) continue;  // blank lines (e.g. a trailing newline)
-    if (!header) {
-      k = static_cast<int>(lp.integer("k"));
-      levels = static_cast<int>(lp.integer("L"));
-      scoring = parseScoring(lp.integer("scoring type"), where);
-      weighting = parseWeighting(lp.integer("weighting type"), where);
-      if (!lp.atEnd()) lp.fail("unexpected text after 'k L scoring weighting'");
-      if (k < 2 || levels < 1) lp.fail("invalid k=" + std::to_string(k) + " L=" + std::to_string(levels));
-      header = true;
-      continue;
+    if (!have_header) {
+      header = parseTextHeader(lp, where);
+      have_header = true;
+    } else {
+      parseNodeLine(lp, line_no, nodes);
     }
-    const long pid = lp.integer("parent id");
-    const long leaf = lp.integer("is_leaf flag");
-    if (pid < 0 || static_cast<size_t>(pid) >= parents.size())
-      lp.fail("parent id " + std::to_string(pid) + " does not name an earlier node (nodes so far: " +
-              std::to_string(parents.size()) + ")");
-    if (leaf != 0 && leaf != 1) lp.fail("is_leaf must be 0 or 1, got " + std::to_string(leaf));
-    if (declared_leaf[pid])
-      lp.fail("parent " + std::to_string(pid) + " was declared a leaf (line " +
-              std::to_string(node_line[pid]) + ")");
-    for (int b = 0; b < kDescriptorBytes; ++b) {
-      const long v = lp.integer("descriptor byte");
-      if (v < 0 || v > 255) lp.fail("descriptor byte " + std::to_string(v) + " out of 0..255");
-      desc.push_back(static_cast<uint8_t>(v));
-    }
-    const double w = lp.real("weight");
-    if (!lp.atEnd()) lp.fail("unexpected text after the weight (expected 32 descriptor bytes then one weight)");
-    parents.push_back(static_cast<uint32_t>(pid));
-    weights.push_back(w);
-    declared_leaf.push_back(static_cast<uint8_t>(leaf));
-    node_line.push_back(line_no);
   }
-  if (!header) throw Error(path + ": empty vocabulary text file (expected 'k L scoring weighting')");
-  // A node declared inner must have children (else it would silently swallow descriptors).
-  std::vector<uint8_t> has_child(parents.size(), 0);
-  for (size_t i = 1; i < parents.size(); ++i) has_child[parents[i]] = 1;
-  for (size_t i = 1; i < parents.size(); ++i)
-    if (!declared_leaf[i] && !has_child[i])
-      throw Error(path + ":" + std::to_string(node_line[i]) + ": node " + std::to_string(i) +
-                  " is declared inner (is_leaf 0) but has no children");
-  return fromNodes(k, levels, weighting, scoring, parents, desc, weights, {}, path);
+  if (!have_header) throw Error(path + ": empty vocabulary text file (expected 'k L scoring weighting')");
+  checkInnerNodesHaveChildren(nodes, path);
+  return fromNodes(header.k, header.levels, header.weighting, header.scoring, nodes.parents, nodes.desc,
+                   nodes.weights, {}, path);
 }
 
 void Vocabulary::save(const std::string& path) const {
