@@ -45,12 +45,11 @@ struct Work {
   std::vector<uint32_t> members;
 };
 
-// k-majority on one node's descriptors; returns the non-empty clusters' centres and members.
-void cluster(const std::vector<Desc>& data, const std::vector<uint32_t>& members, int k,
-             int max_iterations, std::mt19937_64& rng, std::vector<Desc>& centres,
-             std::vector<std::vector<uint32_t>>& groups) {
+// k-means++ seeding: the first centre drawn uniformly, each next one with probability
+// proportional to the squared distance to the nearest centre so far.
+void seedCentres(const std::vector<Desc>& data, const std::vector<uint32_t>& members, int k,
+                 std::mt19937_64& rng, std::vector<Desc>& centres) {
   const size_t n = members.size();
-  // k-means++ seeding: next centre drawn with probability proportional to squared distance.
   centres.clear();
   centres.push_back(data[members[std::uniform_int_distribution<size_t>(0, n - 1)(rng)]]);
   std::vector<double> d2(n);
@@ -77,35 +76,26 @@ void cluster(const std::vector<Desc>& data, const std::vector<uint32_t>& members
       d2[i] = std::min(d2[i], d * d);
     }
   }
-  const size_t kc = centres.size();
-  std::vector<uint32_t> assign(n, 0xffffffffu);
-  for (int it = 0; it < std::max(1, max_iterations); ++it) {
-    bool changed = false;
-    for (size_t i = 0; i < n; ++i) {
-      const Desc& d = data[members[i]];
-      uint32_t best = 0;
-      int best_d = hamming(d, centres[0]);
-      for (size_t c = 1; c < kc; ++c) {
-        const int dc = hamming(d, centres[c]);
-        if (dc < best_d) {
-          best_d = dc;
-          best = static_cast<uint32_t>(c);
-        }
-      }
-      if (assign[i] != best) {
-        assign[i] = best;
-        changed = true;
-      }
+}
+
+// The nearest centre (first of equals) of a descriptor.
+uint32_t nearestCentre(const Desc& d, const std::vector<Desc>& centres) {
+  uint32_t best = 0;
+  int best_d = hamming(d, centres[0]);
+  for (size_t c = 1; c < centres.size(); ++c) {
+    const int dc = hamming(d, centres[c]);
+    if (dc < best_d) {
+      best_d = dc;
+      best = static_cast<uint32_t>(c);
     }
-    groups.assign(kc, {});
-    for (size_t i = 0; i < n; ++i) groups[assign[i]].push_back(members[i]);
-    if (!changed && it > 0) break;
-    for (size_t c = 0; c < kc; ++c)
-      if (!groups[c].empty()) centres[c] = majority(data, groups[c]);
   }
-  // Drop empty clusters.
+  return best;
+}
+
+// Removes the clusters left without members, keeping the others' order.
+void dropEmptyClusters(std::vector<Desc>& centres, std::vector<std::vector<uint32_t>>& groups) {
   size_t out = 0;
-  for (size_t c = 0; c < kc; ++c) {
+  for (size_t c = 0; c < centres.size(); ++c) {
     if (groups[c].empty()) continue;
     if (out != c) {
       centres[out] = centres[c];
@@ -115,6 +105,31 @@ void cluster(const std::vector<Desc>& data, const std::vector<uint32_t>& members
   }
   centres.resize(out);
   groups.resize(out);
+}
+
+// k-majority on one node's descriptors; returns the non-empty clusters' centres and members.
+void cluster(const std::vector<Desc>& data, const std::vector<uint32_t>& members, int k,
+             int max_iterations, std::mt19937_64& rng, std::vector<Desc>& centres,
+             std::vector<std::vector<uint32_t>>& groups) {
+  const size_t n = members.size();
+  seedCentres(data, members, k, rng, centres);
+  std::vector<uint32_t> assign(n, 0xffffffffu);
+  for (int it = 0; it < std::max(1, max_iterations); ++it) {
+    bool changed = false;
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t best = nearestCentre(data[members[i]], centres);
+      if (assign[i] != best) {
+        assign[i] = best;
+        changed = true;
+      }
+    }
+    groups.assign(centres.size(), {});
+    for (size_t i = 0; i < n; ++i) groups[assign[i]].push_back(members[i]);
+    if (!changed && it > 0) break;
+    for (size_t c = 0; c < centres.size(); ++c)
+      if (!groups[c].empty()) centres[c] = majority(data, groups[c]);
+  }
+  dropEmptyClusters(centres, groups);
 }
 
 uint64_t mix(uint64_t x) {  // splitmix64 finaliser: per-node seeds from (seed, node id)
