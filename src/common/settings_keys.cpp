@@ -196,6 +196,8 @@ const std::vector<std::string>& knownSettingsKeys() {
       "Tracking.motionPriorDeg",
       "Tracking.motionPriorFrames",
       "Tracking.minInliers",
+      "Tracking.relocMargin",
+      "Tracking.relocMaxSpeed",
       "Tracking.relocMinInliers",
       "Tracking.motionWindow",
       "Tracking.refRatio",

@@ -38,6 +38,8 @@ const OptionTable<TrackingOptions>& trackingFields() {
       {"Tracking.maxJumpDeg", &O::max_jump_deg, Range::closed(0, 180)},
       {"Tracking.maxJumpInliers", &O::max_jump_inliers, Range::atLeast(0)},
       {"Tracking.maxJumpLocalization", &O::max_jump_localization, Range::closed(0, 1e6)},
+      {"Tracking.relocMaxSpeed", &O::reloc_max_speed, Range::closed(0, 1e6)},
+      {"Tracking.relocMargin", &O::reloc_margin, Range::closed(0, 1e6)},
       {"Tracking.maxStampGap", &O::max_stamp_gap, Range::closed(1e-3, 1e6)},
       {"Tracking.localMapFromPrediction", &O::local_map_from_prediction},
       {"Tracking.youngPointCheck", &O::young_point_check},

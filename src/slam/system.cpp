@@ -495,11 +495,12 @@ SystemStats System::stats() const {
   LocalMappingTimings lm = mapper_->phaseTimings();
   size_t culled = mapper_->culledKeyFrames();
   size_t relocs = 0, jumps = 0, from_prediction = 0, young_dropped = 0, boxed_withheld = 0, dropped_matched = 0,
-         vo_frames = 0, prior_mean_step = 0;
+         vo_frames = 0, prior_mean_step = 0, relocs_refused = 0;
   {
     std::lock_guard<std::mutex> tl(track_mutex_);
     relocs = tracker_->relocalizations();
     jumps = tracker_->jumpsRefused();
+    relocs_refused = tracker_->relocalizationsRefused();
     from_prediction = tracker_->trackedFromPrediction();
     young_dropped = tracker_->youngPointsDropped();
     prior_mean_step = tracker_->priorFromMeanStep();
@@ -522,6 +523,7 @@ SystemStats System::stats() const {
   s.keyframes_culled = culled;
   s.relocalizations = relocs;
   s.jumps_refused = jumps;
+  s.relocalizations_refused = relocs_refused;
   s.tracked_from_prediction = from_prediction;
   s.young_points_dropped = young_dropped;
   s.prior_from_mean_step = prior_mean_step;
@@ -562,6 +564,7 @@ Json statsCountsJson(const SystemStats& s) {
               {"map_resets", s.resets},
               {"relocalizations", s.relocalizations},
               {"jumps_refused", s.jumps_refused},
+              {"relocalizations_refused", s.relocalizations_refused},
               {"tracked_from_prediction", s.tracked_from_prediction},
               {"young_points_dropped", s.young_points_dropped},
               {"prior_from_mean_step", s.prior_from_mean_step},

@@ -114,29 +114,68 @@ TEST(SlamRelocalization, FramesAfterRelocalisationNeedRelocMinInliers) {
   EXPECT_GE(r.relocalizations, 10u);
 }
 
-// The frame right after a relocalisation has no velocity: when its reference keyframe (the
-// one it relocalised on) does not track it either, it relocalises at once. The camera circles
-// an empty room (static_xyz's room on the loop path); after a loss it jumps back to frame 10
-// (relocalised there), then on to frame 190, a wall 55 degrees further round that frame 10's
-// keyframe does not see well: frame 190 is tracked, by a second relocalisation.
-TEST(SlamRelocalization, FrameAfterARelocalisationRelocalisesAtOnce) {
+namespace {
+
+struct OnwardJump {
+  slam::TrackingState state = slam::TrackingState::NotInitialized;  // of frame 190
+  size_t relocalizations = 0, refused = 0;  // after the loss
+  double err = -1;  // frame 190's pose error (m) when it was tracked
+};
+
+// The camera circles an empty room (static_xyz's room on the loop path); after a loss it jumps
+// back to frame 10 (0.76 m from frame 199, a second later: relocalised there), then on to frame
+// 190, 0.73 m from frame 10 and a wall 55 degrees further round that frame 10's keyframe does not
+// see well, stamped `gap_s` after frame 10.
+OnwardJump jumpBackThenOn(double gap_s, double reloc_max_speed) {
   sim::SynthOptions so = test_support::staticXyz(200, 5);
   so.trajectory = "loop";
   sim::SequenceGenerator gen(so);
-  slam::System sys(gen.camera(), test_support::plainSequentialOptions(), shippedVocabulary());
+  slam::SystemOptions opt = test_support::plainSequentialOptions();
+  opt.slam.tracking.reloc_max_speed = reloc_max_speed;
+  slam::System sys(gen.camera(), opt, shippedVocabulary());
   double stamp = trackThenBlank(sys, gen, gen.size(), 3);
-  ASSERT_EQ(sys.state(), slam::TrackingState::Lost);
+  EXPECT_EQ(sys.state(), slam::TrackingState::Lost);
   const size_t relocs_before = sys.stats().relocalizations;
-  stamp += 1.0 / 30;
+  stamp += 1.0;
   const sim::SynthFrame back = gen.frame(10);
-  ASSERT_EQ(sys.trackRgbd(back.bgr, back.depth, stamp, {}).state, slam::TrackingState::Ok);
-  stamp += 1.0 / 30;
+  EXPECT_EQ(sys.trackRgbd(back.bgr, back.depth, stamp, {}).state, slam::TrackingState::Ok);
   const sim::SynthFrame on = gen.frame(190);
-  const slam::TrackResult r = sys.trackRgbd(on.bgr, on.depth, stamp, {});
-  EXPECT_EQ(r.state, slam::TrackingState::Ok);
-  EXPECT_EQ(sys.stats().relocalizations - relocs_before, 2u);
+  const slam::TrackResult r = sys.trackRgbd(on.bgr, on.depth, stamp + gap_s, {});
+  OnwardJump out;
+  out.state = r.state;
+  out.relocalizations = sys.stats().relocalizations - relocs_before;
+  out.refused = sys.stats().relocalizations_refused;
   const Pose gt = gen.frame(0).T_wc.inverse() * on.T_wc;
-  EXPECT_LT((gt.translation() - r.T_wc.translation()).norm(), 0.03);
+  if (r.state == slam::TrackingState::Ok) out.err = (gt.translation() - r.T_wc.translation()).norm();
+  return out;
+}
+
+}  // namespace
+
+// The frame right after a relocalisation has no velocity: when its reference keyframe (the
+// one it relocalised on) does not track it either, it relocalises at once. Frame 190 comes 0.6 s
+// after frame 10, time enough for a camera to get there (Tracking.relocMaxSpeed 1.5 m/s).
+TEST(SlamRelocalization, FrameAfterARelocalisationRelocalisesAtOnce) {
+  const OnwardJump run = jumpBackThenOn(0.6, slam::TrackingOptions().reloc_max_speed);
+  EXPECT_EQ(run.state, slam::TrackingState::Ok);
+  EXPECT_EQ(run.relocalizations, 2u);
+  EXPECT_EQ(run.refused, 0u);
+  EXPECT_LT(run.err, 0.03);
+}
+
+// A frame a camera cannot have reached since the last tracked one (0.73 m in a frame's time) is
+// not relocalised: a place recognised wrongly would move it as far. With the bound off
+// (ORB-SLAM2) the same frame is relocalised.
+TEST(SlamRelocalization, RelocalisationOutOfReachIsRefused) {
+  const OnwardJump bounded = jumpBackThenOn(1.0 / 30, slam::TrackingOptions().reloc_max_speed);
+  EXPECT_NE(bounded.state, slam::TrackingState::Ok);
+  EXPECT_EQ(bounded.relocalizations, 1u);
+  EXPECT_GE(bounded.refused, 1u);
+  const OnwardJump unbounded = jumpBackThenOn(1.0 / 30, 0.0);
+  EXPECT_EQ(unbounded.state, slam::TrackingState::Ok);
+  EXPECT_EQ(unbounded.relocalizations, 2u);
+  EXPECT_EQ(unbounded.refused, 0u);
+  EXPECT_LT(unbounded.err, 0.03);
 }
 
 // A map reset forgets the relocalisations of the old map: Tracking.relocMinInliers out of reach

@@ -78,6 +78,13 @@ struct TrackingOptions {
   // refused pose costs a relocalisation in a good map, a kept one that a crowd dragged off costs
   // the robot its place (held-out crowd seed 51: 0.31 m off, 29 mm RMSE; 6 mm with 0.05).
   double max_jump_localization = 0.05;  // Tracking.maxJumpLocalization (m)
+  // Beyond ORB-SLAM2: a pose found while lost (a relocalisation, or the last keyframes tracked
+  // from the last good pose) farther from the last tracked pose than relocMaxSpeed times the
+  // time since that frame, plus relocMargin, is refused and the frame stays lost: a camera cannot
+  // get there, and a place recognised wrongly on the few keypoints a person leaving the lens lets
+  // through moved a held-out run by 0.7-0.9 m. 0: off (ORB-SLAM2).
+  double reloc_max_speed = 1.5;     // Tracking.relocMaxSpeed (m/s)
+  double reloc_margin = 0.15;       // Tracking.relocMargin (m)
   double max_stamp_gap = 1.0;       // Tracking.maxStampGap (s): a larger gap drops the motion model
   // Beyond ORB-SLAM2: when the motion model and the reference keyframe both fail on a frame the
   // constant-velocity model predicts, the local map is searched from the prediction (the

@@ -68,6 +68,7 @@ struct SystemStats {
   size_t keyframes_culled = 0;
   size_t relocalizations = 0, loops_closed = 0, global_bas = 0;
   size_t jumps_refused = 0;  // poses refused as a jump from the motion model (Tracking.maxJump)
+  size_t relocalizations_refused = 0;  // relocalised poses out of reach (Tracking.relocMaxSpeed)
   size_t tracked_from_prediction = 0;  // frames tracked from the prediction (Tracking.localMapFromPrediction)
   size_t young_points_dropped = 0;     // matches released by Tracking.youngPointCheck
   size_t prior_from_mean_step = 0;     // frames whose motion prior the mean step placed (Tracking.motionPriorFrames)
@@ -92,7 +93,7 @@ std::vector<double> extractionPlusTrackingMs(const SystemStats& s);
 
 // The counts of stats.json, shared by System::statsJson and yolo_slam_run: frames, tracked,
 // lost, keyframes, keyframes_culled, map_points, map_resets, relocalizations, jumps_refused,
-// tracked_from_prediction, young_points_dropped, prior_from_mean_step, boxed_points_withheld, dropped_map_matches, vo_frames, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
+// relocalizations_refused, tracked_from_prediction, young_points_dropped, prior_from_mean_step, boxed_points_withheld, dropped_map_matches, vo_frames, loops_closed, global_bundle_adjustments, keypoints {...}, temporal
 // {...}, boxes_screened {...},
 // feature_budget_mean (nFeatures multiples extracted, mean over the frames).
 Json statsCountsJson(const SystemStats& s);

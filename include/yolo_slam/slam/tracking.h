@@ -70,6 +70,7 @@ class Tracking {
   size_t relocalizations() const { return relocalizations_; }
   // Frames whose pose was refused as a jump from the motion model (Tracking.maxJump).
   size_t jumpsRefused() const { return jumps_refused_; }
+  size_t relocalizationsRefused() const { return relocalizations_refused_; }
   // Frames tracked from the motion model's prediction alone (Tracking.localMapFromPrediction).
   size_t trackedFromPrediction() const { return from_prediction_; }
   // Matches of once-seen map points released by Tracking.youngPointCheck.
@@ -97,6 +98,7 @@ class Tracking {
   // T_cw (tracked on inliers_) lies farther from the constant-velocity prediction than a camera
   // moves in a frame, on too few inliers to trust it (TrackingOptions::max_jump).
   bool implausibleJump(const Pose& T_cw, const Pose& prediction) const;
+  bool unreachableRelocalization(const Frame& F) const;
   // The motion prior for F (TrackingOptions::motion_prior), sigmas scaled by the frames since the
   // last frame.
   optimization::PosePrior motionPrior(const Frame& F, const Pose& prediction) const;
@@ -212,6 +214,7 @@ class Tracking {
   // optimisation of that frame uses it.
   std::optional<optimization::PosePrior> prior_;
   size_t frames_ = 0, tracked_ = 0, lost_ = 0, resets_ = 0, relocalizations_ = 0, jumps_refused_ = 0;
+  size_t relocalizations_refused_ = 0;
   size_t from_prediction_ = 0;
   size_t young_dropped_ = 0;  // matches released by the young-point check
   size_t prior_mean_step_ = 0;  // frames whose prior the mean step placed
