@@ -138,6 +138,8 @@ Tracking.maxJumpDeg: 7.5
 Tracking.maxJumpInliers: 90
 Tracking.maxJumpLocalization: 0.0625
 Tracking.maxStampGap: 0.5
+Tracking.relocMaxSpeed: 0.75
+Tracking.relocMargin: 0.25
 Tracking.localMapFromPrediction: 0
 Tracking.youngPointCheck: 0
 Tracking.boxedPointsStaticOnly: 0
@@ -308,6 +310,7 @@ TEST(Options, EveryFieldHoldsItsValue) {
   EXPECT_EQ(std::tie(k.motion_prior, k.motion_prior_deg, k.max_jump, k.max_jump_deg, k.max_jump_inliers),
             std::make_tuple(0.03125, 1.5, 0.125, 7.5, 90));
   EXPECT_EQ(k.max_jump_localization, 0.0625);
+  EXPECT_EQ(std::tie(k.reloc_max_speed, k.reloc_margin), std::make_tuple(0.75, 0.25));
   EXPECT_EQ(k.motion_prior_frames, 6);
   const slam::LocalMappingOptions& p = sys.slam.mapping;
   EXPECT_EQ(std::tie(p.triangulation_neighbours, p.fuse_neighbours, p.culling_redundancy, p.local_ba, p.queue_size,
