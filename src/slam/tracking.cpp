@@ -533,10 +533,7 @@ bool Tracking::trackWhenLost(Frame& F) {
   for (const auto& kf : cands) {
     if (kf->bad) continue;
     if (trackReferenceKeyFrame(F, kf, prior, kLostMinMapMatches)) {
-      if (unreachableRelocalization(F)) {
-        ++relocalizations_refused_;
-        continue;
-      }
+      if (refusedAsUnreachable(F)) continue;
       ref_kf_ = kf;
       return true;
     }
@@ -545,10 +542,7 @@ bool Tracking::trackWhenLost(Frame& F) {
     // so the pose comes from PnP on the keyframe's matches, as a relocalisation near the place
     // where tracking was lost, which also needs fewer inliers than one over the whole map.
     if (relocalizeOn(F, kf, kLostMinMapMatches)) {
-      if (unreachableRelocalization(F)) {
-        ++relocalizations_refused_;
-        continue;
-      }
+      if (refusedAsUnreachable(F)) continue;
       acceptRelocalization(F, kf);
       return true;
     }
@@ -571,10 +565,7 @@ bool Tracking::relocalize(Frame& F) {
   if (cands.size() > kMaxRelocCandidates) cands.resize(kMaxRelocCandidates);
   for (const KeyFramePtr& kf : cands) {
     if (!relocalizeOn(F, kf, kRelocMinInliers)) continue;
-    if (unreachableRelocalization(F)) {
-      ++relocalizations_refused_;
-      continue;
-    }
+    if (refusedAsUnreachable(F)) continue;
     acceptRelocalization(F, kf);
     return true;
   }
@@ -583,14 +574,16 @@ bool Tracking::relocalize(Frame& F) {
 }
 
 // TrackingOptions::reloc_max_speed: the pose F holds, found while lost, lies farther from the last
-// good pose than the camera can have moved since the last tracked frame.
-bool Tracking::unreachableRelocalization(const Frame& F) const {
+// good pose than the camera can have moved since the last tracked frame; a refusal is counted.
+bool Tracking::refusedAsUnreachable(const Frame& F) {
   if (opt_.reloc_max_speed <= 0 || !has_last_good_ || !has_last_) return false;
   // Time going backwards (a bag played again) says nothing of how far the camera went.
   const double dt = F.stamp - last_.stamp;
   if (!std::isfinite(dt) || dt < 0) return false;
   const double moved = (F.Twc().translation() - last_good_T_wc_.translation()).norm();
-  return moved > opt_.reloc_max_speed * dt + opt_.reloc_margin;
+  if (moved <= opt_.reloc_max_speed * dt + opt_.reloc_margin) return false;
+  ++relocalizations_refused_;
+  return true;
 }
 
 void Tracking::acceptRelocalization(const Frame& F, const KeyFramePtr& kf) {

@@ -98,7 +98,7 @@ class Tracking {
   // T_cw (tracked on inliers_) lies farther from the constant-velocity prediction than a camera
   // moves in a frame, on too few inliers to trust it (TrackingOptions::max_jump).
   bool implausibleJump(const Pose& T_cw, const Pose& prediction) const;
-  bool unreachableRelocalization(const Frame& F) const;
+  bool refusedAsUnreachable(const Frame& F);
   // The motion prior for F (TrackingOptions::motion_prior), sigmas scaled by the frames since the
   // last frame.
   optimization::PosePrior motionPrior(const Frame& F, const Pose& prediction) const;
