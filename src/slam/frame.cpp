@@ -146,8 +146,7 @@ int Frame::countWithDepth() const {
 
 bool Frame::seenMoving(int i) const {
   if (testedMoving(i)) return true;
-  const bool static_consistent = !motion.empty() && motion[i] == 1;
-  return !boxed.empty() && boxed[i] && !static_consistent;
+  return !boxed.empty() && boxed[i] && !staticConsistent(i);
 }
 
 std::vector<std::pair<float, int>> Frame::staticByDepth() const {

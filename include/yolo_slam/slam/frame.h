@@ -74,6 +74,8 @@ class Frame {
   bool seenMoving(int i) const;
   // The frame-to-frame test saw keypoint i move (motion 0); false when it did not run.
   bool testedMoving(int i) const { return !motion.empty() && motion[i] == 0; }
+  // The frame-to-frame test found keypoint i where a static point would be (motion 1).
+  bool staticConsistent(int i) const { return !motion.empty() && motion[i] == 1; }
   // Frees the keypoints, descriptors, BoW and grid (N becomes 0), keeping pose and camera. For
   // erased keyframes: the trajectory still refers to them for its relative poses, and without
   // this each would keep its features (about 250 KB) for the rest of the run.
